@@ -1,0 +1,33 @@
+"""Control-mesh geometry: the mesh container and its validation, analytic primitives, mesh file
+input/output and region predicates."""
+
+from graspdef.geometry.io import LENGTH_UNITS, length_scale, load_mesh, save_ply
+from graspdef.geometry.mesh import (
+    TriMesh,
+    boundary_edges,
+    boundary_loops,
+    edge_face_counts,
+    is_closed,
+    unique_edges,
+    validate_mesh,
+    vertex_valence,
+)
+from graspdef.geometry.primitives import (
+    cylinder,
+    ellipsoid,
+    height_field,
+    hemisphere,
+    icosphere,
+    monkey_saddle,
+    rectangle,
+    sphere,
+    square_plate,
+)
+from graspdef.geometry.regions import compile_predicate
+
+__all__ = [
+    "LENGTH_UNITS", "TriMesh", "boundary_edges", "boundary_loops", "compile_predicate",
+    "cylinder", "edge_face_counts", "ellipsoid", "height_field", "hemisphere", "icosphere",
+    "is_closed", "length_scale", "load_mesh", "monkey_saddle", "rectangle", "save_ply", "sphere",
+    "square_plate", "unique_edges", "validate_mesh", "vertex_valence",
+]

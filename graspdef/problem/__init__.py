@@ -1,0 +1,1 @@
+"""Loads, supports and the Problem every solver receives."""

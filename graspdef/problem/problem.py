@@ -1,0 +1,97 @@
+"""The Problem: a shell with loads, supports and named probe points; what every solver receives."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..errors import ProblemError
+from ..shell.model import Shell
+from ..subdivision.evaluate import SurfaceEvaluator, project_point
+from .loads import PointLoad, load_vector
+from .supports import check_rigid_modes, constraint_rows, independent_rows, nitsche_matrix
+
+
+@dataclass(frozen=True)
+class SurfacePoint:
+    """A point of the limit surface: real face index and barycentric coordinates."""
+
+    face: int
+    bary: tuple[float, float, float]
+
+
+def make_evaluator(shell: Shell) -> SurfaceEvaluator:
+    return SurfaceEvaluator(shell.mesh.faces, shell.n_control)
+
+
+def locate(shell: Shell, ev: SurfaceEvaluator, point, name: str, tol: float | None = None,
+           n_candidates: int = 8) -> tuple[SurfacePoint, float]:
+    """Closest limit-surface point to ``point`` [m].
+
+    Raises ProblemError when it is farther than ``tol`` (default: half the mean edge length of
+    the control mesh) -- a probe or load off the surface."""
+    p = np.asarray(point, dtype=float)
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ProblemError(f"{name}: position must be three finite numbers, got {point!r}")
+    x = shell.rest_positions
+    real = shell.mesh.faces[: shell.mesh.n_real_faces]
+    cent = x[real].mean(axis=1)
+    k = min(n_candidates, len(real))
+    _, cand = cKDTree(cent).query(p, k=k)
+    face, bary, dist = project_point(ev, x, p, np.atleast_1d(cand))
+    if tol is None:
+        e = x[real[:, [1, 2, 0]]] - x[real]
+        tol = 0.5 * float(np.linalg.norm(e, axis=-1).mean())
+    if dist > tol:
+        raise ProblemError(f"{name}: point {p.tolist()} is off the surface (nearest limit-surface point "
+                           f"is {dist:.3g} m away; tolerance {tol:.3g} m)")
+    return SurfacePoint(face, tuple(float(b) for b in bary)), dist
+
+
+@dataclass
+class Problem:
+    """Shell + loads + supports + probes.
+
+    Parameters
+    ----------
+    shell : Shell
+    loads : list of PointLoad | Pressure | BodyForce
+    supports : list of EdgeSupport | PointSupport | RigidModes
+    probes : name -> SurfacePoint, where displacements are reported
+    n_collocation : collocation points per supported boundary edge
+    """
+
+    shell: Shell
+    loads: list
+    supports: list
+    probes: dict[str, SurfacePoint] = field(default_factory=dict)
+    n_collocation: int = 2
+
+    def __post_init__(self) -> None:
+        self.evaluator = make_evaluator(self.shell)
+        n_real = self.shell.mesh.n_real_faces
+        for ld in self.loads:
+            if isinstance(ld, PointLoad) and not (0 <= ld.face < n_real):
+                raise ProblemError(f"point load on face {ld.face}: the mesh has faces 0..{n_real - 1}")
+        for name, sp_ in self.probes.items():
+            if not (0 <= sp_.face < n_real):
+                raise ProblemError(f"probe '{name}' on face {sp_.face}: the mesh has faces 0..{n_real - 1}")
+        if not self.supports:
+            raise ProblemError("no supports: add supports, or RigidModes for a body held only by loads")
+
+    def load_vector(self) -> np.ndarray:
+        """External force vector (3 n_control,) [N]."""
+        return load_vector(self.shell, self.loads, self.evaluator)
+
+    def boundary_stiffness(self):
+        """Nitsche terms for rotation-fixed edges, (3 n_control, 3 n_control) sparse."""
+        return nitsche_matrix(self.shell, self.supports, self.evaluator)
+
+    def constraints(self):
+        """C (m, 3 n_control) and row labels; raises SupportError if rigid modes stay free."""
+        C, labels = constraint_rows(self.shell, self.supports, self.evaluator, self.n_collocation)
+        keep = independent_rows(C)
+        C, labels = C[keep], [labels[i] for i in keep]
+        check_rigid_modes(C, self.shell.rest_positions)
+        return C, labels

@@ -1,0 +1,325 @@
+"""Supports as linear constraints on the limit surface, ``C u = 0``.
+
+Each supported boundary edge contributes collocation points (Gauss-Legendre along the edge's
+limit curve).  At each point the limit displacement ``u = sum N_i u_i`` is constrained in the
+support's directions; with two points per edge this makes the constrained components vanish
+identically along the whole limit boundary curve (dependent rows are dropped, see
+``independent_rows``).  The constraints are imposed by Lagrange multipliers (``graspdef.solve``);
+ghost control vertices stay free, so natural boundary conditions come out of the energy.
+
+The rotation about the edge (``clamped``, ``symmetry``) is imposed by Nitsche's method
+(``nitsche_matrix``): imposing it exactly as well would leave the box-spline space no curvature
+at the edge (measured: first-order convergence of the clamped plate), while Nitsche's consistent
+weak form keeps the full convergence rate.
+
+=================  =====================================  ==================
+kind               displacement constrained               rotation about edge
+=================  =====================================  ==================
+free               nothing                                free
+simply_supported   all three components (hinge)           free
+clamped            all three components                   fixed
+symmetry           component along the plane normal       fixed
+diaphragm          the two components in the diaphragm    free
+                   plane (normal to ``normal``)
+=================  =====================================  ==================
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import ProblemError, SupportError
+from ..shell.model import Shell
+from ..subdivision.evaluate import SurfaceEvaluator
+
+KINDS = ("free", "simply_supported", "clamped", "symmetry", "diaphragm")
+
+
+def _unit(name: str, v) -> np.ndarray:
+    a = np.asarray(v, dtype=float)
+    if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) == 0:
+        raise ProblemError(f"{name} must be a non-zero 3-vector, got {v!r}")
+    return a / np.linalg.norm(a)
+
+
+@dataclass(frozen=True)
+class EdgeSupport:
+    """Support on the boundary edges whose two end vertices satisfy ``where``.
+
+    Parameters
+    ----------
+    kind : one of ``KINDS``
+    where : callable (n, 3) -> (n,) bool, evaluated on rest vertex positions [m]
+    normal : plane normal (symmetry) or diaphragm-plane normal (diaphragm)
+    name : label used in messages
+    """
+
+    kind: str
+    where: Callable[[np.ndarray], np.ndarray]
+    normal: tuple[float, float, float] | None = None
+    name: str = "support"
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ProblemError(f"support '{self.name}': unknown kind '{self.kind}' (valid: {', '.join(KINDS)})")
+        if self.kind in ("symmetry", "diaphragm") and self.normal is None:
+            raise ProblemError(f"support '{self.name}': kind '{self.kind}' needs a 'normal' vector")
+
+    def directions(self) -> tuple[np.ndarray, bool]:  # noqa: D401
+        """Constrained displacement directions (k, 3) and whether the rotation is fixed."""
+        if self.kind == "free":
+            return np.zeros((0, 3)), False
+        if self.kind in ("simply_supported", "clamped"):
+            return np.eye(3), self.kind == "clamped"
+        n = _unit(f"support '{self.name}' normal", self.normal)
+        if self.kind == "symmetry":
+            return n[None, :], True
+        # diaphragm: the plane normal to n
+        basis = np.linalg.svd(np.eye(3) - np.outer(n, n))[0][:, :2].T
+        return basis, False
+
+
+@dataclass(frozen=True)
+class PointSupport:
+    """Displacement of one limit-surface point fixed along ``directions`` (k, 3)."""
+
+    face: int
+    bary: tuple[float, float, float]
+    directions: tuple[tuple[float, float, float], ...] = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
+    name: str = "point"
+
+
+@dataclass(frozen=True)
+class RigidModes:
+    """Removes the six rigid-body modes of an unsupported body: the control-point displacements
+    are made orthogonal to the rigid translations and rotations (about the centroid).  Exact for
+    self-equilibrated loads; the load's net force and moment are reported by the solver."""
+
+    name: str = "rigid_modes"
+
+
+Support = EdgeSupport | PointSupport | RigidModes
+
+
+def rigid_modes(x: np.ndarray) -> np.ndarray:
+    """Unit-norm rigid-body modes of control points ``x`` as columns, (3 n, 6):
+    translations x, y, z then rotations about x, y, z through the centroid."""
+    c = x - x.mean(axis=0)
+    cols = [np.tile(e, (len(x), 1)).ravel() for e in np.eye(3)]
+    cols += [np.cross(e, c).ravel() for e in np.eye(3)]
+    R = np.stack(cols, axis=1)
+    return R / np.linalg.norm(R, axis=0)
+
+
+def _edge_points(n_col: int) -> np.ndarray:
+    t, _ = np.polynomial.legendre.leggauss(n_col)
+    return 0.5 * (t + 1.0)
+
+
+_CORNERS = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+
+
+def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: int = 2):
+    """Assemble C (m, 3 n_control) and a per-row label list.
+
+    Returns (C csr, labels list[str], points (m_pts, 3) collocation points for reporting)."""
+    x = shell.rest_positions
+    n = shell.n_control
+    rows, cols, vals, labels = [], [], [], []
+    m = 0
+
+    def add(st, weights, direction, label):
+        nonlocal m
+        rows.append(np.full(3 * len(st), m))
+        cols.append((3 * st[:, None] + np.arange(3)).ravel())
+        vals.append((weights[:, None] * direction[None, :]).ravel())
+        labels.append(label)
+        m += 1
+
+    taus = _edge_points(n_col)
+    mesh = shell.mesh
+    any_edge = False
+    for sup in supports:
+        if isinstance(sup, EdgeSupport):
+            dirs, rot = sup.directions()
+            ab = mesh.boundary_edges
+            if len(ab) == 0:
+                raise SupportError(f"support '{sup.name}': the surface has no boundary edges")
+            mask = np.asarray(sup.where(x[ab[:, 0]]), bool) & np.asarray(sup.where(x[ab[:, 1]]), bool)
+            if not mask.any():
+                raise SupportError(f"support '{sup.name}' ({sup.kind}): its region selects no boundary edge")
+            any_edge = True
+            for e in np.flatnonzero(mask):
+                a, b = ab[e]
+                f = int(mesh.boundary_faces[e])
+                tri = mesh.faces[f]
+                i = int(np.flatnonzero(tri == a)[0])
+                j, k = (i + 1) % 3, (i + 2) % 3
+                pts = (1 - taus)[:, None] * _CORNERS[i] + taus[:, None] * _CORNERS[j]
+                st, N, dN, _ = ev.basis(f, pts)
+                for q in range(len(taus)):
+                    for d in dirs:
+                        add(st, N[q], d, f"{sup.name}: u.{np.round(d, 3).tolist()} at edge {a}-{b}")
+        elif isinstance(sup, PointSupport):
+            st, w = ev.values(sup.face, np.asarray(sup.bary, float))
+            for d in np.asarray(sup.directions, dtype=float):
+                add(st, w, _unit(f"support '{sup.name}' direction", d), f"{sup.name}: u.{d.tolist()}")
+        elif isinstance(sup, RigidModes):
+            R = rigid_modes(x)
+            names = ["translation x", "translation y", "translation z", "rotation x", "rotation y", "rotation z"]
+            for c in range(6):
+                rows.append(np.full(3 * n, m))
+                cols.append(np.arange(3 * n))
+                vals.append(R[:, c])
+                labels.append(f"{sup.name}: {names[c]}")
+                m += 1
+        else:
+            raise ProblemError(f"unknown support object {sup!r}")
+    del any_edge
+    if m == 0:
+        return sp.csr_matrix((0, 3 * n)), labels
+    C = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(m, 3 * n))
+    C.sum_duplicates()
+    return C, labels
+
+
+def check_rigid_modes(C: sp.csr_matrix, x: np.ndarray, rtol: float = 1e-8) -> None:
+    """Raise SupportError naming any rigid-body motion that the constraints leave free."""
+    R = rigid_modes(x)
+    CR = C @ R if C.shape[0] else np.zeros((0, 6))
+    if CR.shape[0] < 6:
+        s = np.zeros(6)
+        vt = np.eye(6)
+        if CR.shape[0]:
+            _, s_, vt_ = np.linalg.svd(CR)
+            s[: len(s_)] = s_
+            vt = vt_ if vt_.shape[0] == 6 else vt
+    else:
+        _, s, vt = np.linalg.svd(CR, full_matrices=True)
+    scale = max(s.max(initial=0.0), 1e-300)
+    free = [vt[i] for i in range(6) if s[i] <= rtol * scale or s[i] == 0.0]
+    if free:
+        desc = []
+        for v in free:
+            v = v / np.abs(v).max()
+            t, r = np.round(v[:3], 3), np.round(v[3:], 3)
+            part = []
+            if np.abs(t).max() > 1e-3:
+                part.append(f"translation along {t.tolist()}")
+            if np.abs(r).max() > 1e-3:
+                part.append(f"rotation about {r.tolist()}")
+            desc.append(" + ".join(part))
+        raise SupportError(
+            f"under-supported: {len(free)} rigid-body mode(s) are free ({'; '.join(desc)}). "
+            "Add supports, or RigidModes ('remove_rigid_modes = true') for a body held only by loads.")
+
+
+def independent_rows(C: sp.csr_matrix, rtol: float = 1e-9, dense_row: int = 10_000) -> np.ndarray:
+    """Indices of a maximal linearly independent subset of the rows of C.
+
+    Collocation on a closed boundary loop is exactly rank-deficient (the limit curve's spline
+    space has one dimension less than two points per edge), so dependent rows are dropped by a
+    pivoted QR on each connected cluster of rows that share columns.  Rows with more than
+    ``dense_row`` non-zeros (rigid-mode rows) are kept as they are."""
+    from scipy.linalg import qr
+    from scipy.sparse.csgraph import connected_components
+
+    m = C.shape[0]
+    if m == 0:
+        return np.zeros(0, np.int64)
+    nnz = np.diff(C.indptr)
+    dense = np.flatnonzero(nnz > dense_row)
+    sparse_rows = np.flatnonzero(nnz <= dense_row)
+    Cs = C[sparse_rows]
+    P = Cs.copy()
+    P.data = np.ones_like(P.data)
+    ncomp, label = connected_components(P @ P.T, directed=False)
+    keep = [dense]
+    for c in range(ncomp):
+        rows = np.flatnonzero(label == c)
+        sub = Cs[rows]
+        cols = np.unique(sub.indices)
+        A = sub[:, cols].toarray()
+        _, R, piv = qr(A.T, mode="economic", pivoting=True)
+        diag = np.abs(np.diag(R))
+        rank = int((diag > rtol * diag[0]).sum()) if len(diag) else 0
+        keep.append(sparse_rows[rows[np.sort(piv[:rank])]])
+    return np.sort(np.concatenate(keep))
+
+
+def nitsche_matrix(shell: Shell, supports: list, ev: SurfaceEvaluator, gamma: float = 20.0,
+                   n_points: int = 3) -> sp.csr_matrix:
+    """Symmetric Nitsche terms that impose a zero rotation about supported edges (linear theory).
+
+    For each edge with a fixed rotation and each Gauss point on its limit curve::
+
+        -int [ m_nn(u) theta(v) + m_nn(v) theta(u) ] ds + int gamma D / h theta(u) theta(v) ds
+
+    with the bending moment m_nn = m^ab nu_a nu_b, the rotation theta = n . du/dnu about the edge,
+    the outward conormal nu, D = E t^3 / (12 (1 - nu^2)) and h the edge length.  Consistent: the
+    exact solution satisfies the weak form, so nothing is regularised (Nitsche 1971; for Kirchhoff
+    plates e.g. Embar, Dolbow & Harari 2010).  ``gamma`` must make the form coercive; the solver's
+    inertia check reports it if it does not.
+    """
+    from ..shell.kinematics import strain_jacobian
+    from ..shell.materials import plane_stress_tensor
+
+    x = shell.rest_positions
+    mesh = shell.mesh
+    mat = shell.material
+    thick = np.broadcast_to(np.asarray(shell.thickness, float), (mesh.n_real_faces,))
+    t_gl, w_gl = np.polynomial.legendre.leggauss(n_points)
+    taus, wts = 0.5 * (t_gl + 1.0), 0.5 * w_gl
+    rows, cols, vals = [], [], []
+    for sup in supports:
+        if not isinstance(sup, EdgeSupport) or not sup.directions()[1]:
+            continue
+        ab = mesh.boundary_edges
+        mask = np.asarray(sup.where(x[ab[:, 0]]), bool) & np.asarray(sup.where(x[ab[:, 1]]), bool)
+        for e in np.flatnonzero(mask):
+            a, b = ab[e]
+            f = int(mesh.boundary_faces[e])
+            tri = mesh.faces[f]
+            i = int(np.flatnonzero(tri == a)[0])
+            pts = (1 - taus)[:, None] * _CORNERS[i] + taus[:, None] * _CORNERS[(i + 1) % 3]
+            st, N, dN, ddN = ev.basis(f, pts)
+            X = x[st]
+            S = len(st)
+            h = float(np.linalg.norm(x[b] - x[a]))
+            t = thick[f]
+            Dplate = mat.E * t ** 3 / (12.0 * (1.0 - mat.nu ** 2))
+            chart_e = _CORNERS[(i + 1) % 3] - _CORNERS[i]
+            for q in range(len(taus)):
+                y = np.concatenate([dN[q], ddN[q]], axis=1).T @ X               # (5, 3)
+                a1, a2 = y[0], y[1]
+                n = np.cross(a1, a2)
+                n /= np.linalg.norm(n)
+                te = chart_e[0] * a1 + chart_e[1] * a2
+                ds = np.linalg.norm(te)
+                tvec = te / ds
+                nu_out = np.cross(tvec, n)
+                A = np.array([[a1 @ a1, a1 @ a2], [a1 @ a2, a2 @ a2]])
+                nu_cov = np.array([nu_out @ a1, nu_out @ a2])
+                nu_con = np.linalg.solve(A, nu_cov)
+                Ainv = np.linalg.inv(A)
+                H = plane_stress_tensor(mat.E, mat.nu, np.array([Ainv[0, 0], Ainv[1, 1], Ainv[0, 1]]))
+                J = strain_jacobian(y[None])[0]                                  # (6, 5, 3)
+                Dm = np.concatenate([dN[q], ddN[q]], axis=1)                     # (S, 5)
+                dkappa = np.einsum("iKa,sK->isa", J[3:], Dm).reshape(3, 3 * S)   # d kappa_voigt / du
+                m_voigt = (t ** 3 / 12.0) * H @ dkappa                           # (3, 3S): m^11, m^22, m^12
+                m_nn = (m_voigt[0] * nu_cov[0] ** 2 + m_voigt[1] * nu_cov[1] ** 2
+                        + 2.0 * m_voigt[2] * nu_cov[0] * nu_cov[1])
+                theta = ((dN[q] @ nu_con)[:, None] * n[None, :]).ravel()         # (3S,)
+                w = wts[q] * ds
+                Ke = w * (-(np.outer(m_nn, theta) + np.outer(theta, m_nn)) + gamma * Dplate / h * np.outer(theta, theta))
+                dofs = (3 * st[:, None] + np.arange(3)).ravel()
+                rows.append(np.repeat(dofs, len(dofs)))
+                cols.append(np.tile(dofs, len(dofs)))
+                vals.append(Ke.ravel())
+    n = shell.n_dofs
+    if not rows:
+        return sp.csr_matrix((n, n))
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))

@@ -1,0 +1,1 @@
+"""Kirchhoff-Love thin shells on Loop-subdivision surfaces: kinematics, materials and energy."""

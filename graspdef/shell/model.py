@@ -1,0 +1,90 @@
+"""A shell: ghosted control mesh + Loop basis + material + thickness, with rest quantities."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ProblemError
+from ..subdivision.basis import LoopBasis, build_basis
+from ..subdivision.ghosts import GhostedMesh, add_ghost_layer
+from .kinematics import fundamental_forms, normal
+from .materials import LinearElastic
+
+
+def surface_derivatives(stencils: np.ndarray, dN: np.ndarray, ddN: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """y = (a1, a2, a11, a22, a12) at quadrature points, (n_faces, n_quad, 5, 3)."""
+    X = x[stencils]                                              # (f, S, 3)
+    D = np.concatenate([dN, ddN], axis=-1)                       # (f|1, q, S, 5)
+    return np.einsum("fqsk,fsd->fqkd", np.broadcast_to(D, (len(stencils),) + D.shape[1:]), X)
+
+
+@dataclass(frozen=True)
+class RestGroup:
+    """Per face group: rest forms, contravariant metric, area weights and thickness."""
+
+    rest_a: np.ndarray          # (f, q, 3)
+    rest_b: np.ndarray          # (f, q, 3)
+    rest_inv: np.ndarray        # (f, q, 3)  A^11, A^22, A^12
+    weights: np.ndarray         # (f, q)  quadrature weight x rest area element
+    thickness: np.ndarray       # (f, 1)
+
+
+@dataclass(frozen=True)
+class Shell:
+    """Thin shell on the limit surface of a Loop control mesh.
+
+    Parameters
+    ----------
+    vertices : (n_vertices, 3) float [m]
+    faces : (n_faces, 3) int, oriented
+    material : LinearElastic (or any object with ``density``)
+    thickness : float or (n_faces,) [m]
+    n_quad : int   Gauss points per face (1, 3, 6 or 12).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    material: LinearElastic
+    thickness: float | np.ndarray
+    n_quad: int = 3
+    mesh: GhostedMesh = field(init=False, repr=False)
+    basis: LoopBasis = field(init=False, repr=False)
+    rest: tuple[RestGroup, ...] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        t = np.asarray(self.thickness, dtype=float)
+        if t.ndim not in (0, 1) or (t.ndim == 1 and len(t) != len(self.faces)):
+            raise ProblemError("thickness must be a number or one value per face")
+        if not np.all(np.isfinite(t)) or np.any(t <= 0):
+            raise ProblemError(f"thickness must be positive and finite, got {self.thickness!r}")
+        mesh = add_ghost_layer(self.vertices, self.faces)
+        basis = build_basis(mesh.faces, mesh.n_control, np.arange(mesh.n_real_faces), self.n_quad)
+        rest = []
+        for g in basis.groups:
+            y = surface_derivatives(g.stencils, g.dN, g.ddN, mesh.vertices)
+            a, b = fundamental_forms(y)
+            det = a[..., 0] * a[..., 1] - a[..., 2] ** 2
+            inv = np.stack([a[..., 1] / det, a[..., 0] / det, -a[..., 2] / det], -1)
+            _, j = normal(y)
+            tg = np.broadcast_to(t, (len(self.faces),))[g.faces][:, None] if t.ndim else np.full((len(g.faces), 1), float(t))
+            rest.append(RestGroup(a, b, inv, j * basis.qweights, tg))
+        object.__setattr__(self, "mesh", mesh)
+        object.__setattr__(self, "basis", basis)
+        object.__setattr__(self, "rest", tuple(rest))
+
+    @property
+    def n_control(self) -> int:
+        return self.mesh.n_control
+
+    @property
+    def n_dofs(self) -> int:
+        return 3 * self.mesh.n_control
+
+    @property
+    def rest_positions(self) -> np.ndarray:
+        return self.mesh.vertices
+
+    def area(self) -> float:
+        """Rest area of the limit surface [m^2]."""
+        return float(sum(r.weights.sum() for r in self.rest))

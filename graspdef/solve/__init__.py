@@ -1,0 +1,1 @@
+"""Solvers: sparse direct KKT solves and the linear problem (Hessian at rest)."""

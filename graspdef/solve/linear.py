@@ -1,0 +1,81 @@
+"""The linear problem: K0 u = f with K0 the Hessian of the shell energy at rest."""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..problem.problem import Problem
+from ..shell.energy import ShellEnergy
+from ..subdivision.rules import limit_matrix
+from .sparse import KKTResult, solve_kkt
+
+
+@dataclass
+class LinearSolution:
+    """Control-point displacements of a linear solve and what is derived from them.
+
+    Attributes
+    ----------
+    problem : Problem
+    u : (n_control, 3) control-point displacements [m]
+    kkt : KKTResult
+    timings : dict of seconds (assembly, constraints, factor, solve)
+    """
+
+    problem: Problem
+    u: np.ndarray
+    kkt: KKTResult
+    timings: dict = field(default_factory=dict)
+    load: np.ndarray | None = None
+
+    @property
+    def strain_energy(self) -> float:
+        """(1/2) f.u [J] (equal to the elastic energy at equilibrium of a linear problem)."""
+        return 0.5 * float(self.load @ self.u.ravel())
+
+    def probe(self, name: str) -> np.ndarray:
+        sp_ = self.problem.probes[name]
+        st, w = self.problem.evaluator.values(sp_.face, np.asarray(sp_.bary))
+        return w @ self.u[st]
+
+    def limit_map(self) -> sp.csr_matrix:
+        mesh = self.problem.shell.mesh
+        return limit_matrix(mesh.faces, mesh.n_control, np.arange(mesh.n_real))
+
+    def vertex_displacements(self) -> np.ndarray:
+        """Limit displacements at the real control vertices, (n_vertices, 3) [m]."""
+        return self.limit_map() @ self.u
+
+    def deformed_surface(self, scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """Limit points of the real vertices after deformation, and the real faces."""
+        mesh = self.problem.shell.mesh
+        L = self.limit_map()
+        return L @ (mesh.vertices + scale * self.u), mesh.faces[: mesh.n_real_faces]
+
+    def max_displacement(self) -> float:
+        return float(np.linalg.norm(self.vertex_displacements(), axis=1).max())
+
+    def net_load(self) -> tuple[np.ndarray, np.ndarray]:
+        """Net force [N] and moment about the origin [N m] of the applied loads."""
+        f = self.load.reshape(-1, 3)
+        x = self.problem.shell.rest_positions
+        return f.sum(0), np.cross(x, f).sum(0)
+
+
+def solve_linear(problem: Problem, backend: str = "auto") -> LinearSolution:
+    """Assemble K0 (Hessian at rest), the load vector and the support constraints, and solve."""
+    t0 = time.perf_counter()
+    shell = problem.shell
+    _, _, K = ShellEnergy(shell).hessian(shell.rest_positions)
+    K = (K + problem.boundary_stiffness()).tocsr()
+    t1 = time.perf_counter()
+    f = problem.load_vector()
+    C, _ = problem.constraints()
+    t2 = time.perf_counter()
+    kkt = solve_kkt(K, C, f, backend=backend)
+    timings = {"assembly": t1 - t0, "loads_constraints": t2 - t1, "factor": kkt.seconds_factor,
+               "solve": kkt.seconds_solve}
+    return LinearSolution(problem, kkt.u.reshape(-1, 3), kkt, timings, f)

@@ -1,0 +1,85 @@
+"""Evaluation of the Loop limit surface at arbitrary points of a control mesh."""
+from __future__ import annotations
+
+import numpy as np
+
+from .basis import _is_regular, irregular_basis, regular_stencils, vertex_faces
+from .halfedge import HalfEdges, face_counts, interior_mask
+from .patch import regular_basis
+from .rules import limit_weight
+
+
+class SurfaceEvaluator:
+    """Basis functions of one control mesh at any (face, chart point); topology built once.
+
+    Parameters
+    ----------
+    faces : (n_faces, 3) int     oriented control mesh (with its ghost layer, if open).
+    n_control : int
+    """
+
+    def __init__(self, faces: np.ndarray, n_control: int):
+        self.faces = np.asarray(faces, dtype=np.int64)
+        self.n_control = int(n_control)
+        self._he = HalfEdges.build(self.faces, self.n_control)
+        self._vf = vertex_faces(self.faces, self.n_control)
+        self._counts = face_counts(self.faces, self.n_control)
+        self._inner = interior_mask(self.faces, self.n_control)
+
+    def basis(self, face: int, pts: np.ndarray):
+        """Stencil (S,), N (q, S), dN (q, S, 2), ddN (q, S, 3) at chart points ``pts`` (q, 2)."""
+        tri = self.faces[face]
+        pts = np.atleast_2d(np.asarray(pts, dtype=float))
+        if _is_regular(tri[None], self._counts, self._inner)[0]:
+            N, dN, ddN = regular_basis(pts)
+            return regular_stencils(self._he, tri[None])[0], N, dN, ddN
+        return irregular_basis(self.faces, self._vf, int(face), pts)
+
+    def values(self, face: int, bary: np.ndarray, tol: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
+        """Control indices (S,) and weights (S,) of the limit point with barycentric coordinates
+        ``bary`` (b0, b1, b2) in ``face`` (chart v = b1, w = b2); exact limit masks at vertices."""
+        b = np.asarray(bary, dtype=float)
+        corner = np.flatnonzero(b > 1.0 - tol)
+        if len(corner):
+            vtx = int(self.faces[face][corner[0]])
+            nbrs = np.unique(self.faces[self._vf[vtx].indices])
+            nbrs = nbrs[nbrs != vtx]
+            chi = float(limit_weight(len(nbrs)))
+            weights = np.concatenate([[1.0 - len(nbrs) * chi], np.full(len(nbrs), chi)])
+            return np.concatenate([[vtx], nbrs]), weights
+        st, N, _, _ = self.basis(face, b[None, 1:3])
+        return st, N[0]
+
+    def point(self, x: np.ndarray, face: int, bary: np.ndarray) -> np.ndarray:
+        """Limit-surface point (3,) of control points ``x`` (n_control, 3)."""
+        st, w = self.values(face, bary)
+        return w @ x[st]
+
+
+def project_point(ev: SurfaceEvaluator, x: np.ndarray, target: np.ndarray, candidates: np.ndarray,
+                  iterations: int = 12) -> tuple[int, np.ndarray, float]:
+    """Closest point of the limit surface (control points ``x``) to ``target`` among the
+    ``candidates`` faces: Gauss-Newton in each face chart, clamped to the triangle.
+
+    Returns (face, barycentric (3,), distance)."""
+    best = (-1, np.zeros(3), np.inf)
+    p = np.asarray(target, dtype=float)
+    for f in np.asarray(candidates, dtype=np.int64):
+        vw = np.array([1.0 / 3.0, 1.0 / 3.0])
+        for _ in range(iterations):
+            st, N, dN, _ = ev.basis(int(f), vw[None])
+            X = x[st]
+            r = N[0] @ X - p
+            A = dN[0].T @ X                                  # (2, 3): a1, a2
+            step = np.linalg.lstsq(A @ A.T, -(A @ r), rcond=None)[0]
+            vw = vw + step
+            vw = np.clip(vw, 0.0, 1.0)
+            if vw.sum() > 1.0:
+                vw = vw / vw.sum()
+            if np.linalg.norm(step) < 1e-13:
+                break
+        bary = np.array([1.0 - vw.sum(), vw[0], vw[1]])
+        d = float(np.linalg.norm(ev.point(x, int(f), bary) - p))
+        if d < best[2]:
+            best = (int(f), bary, d)
+    return best
