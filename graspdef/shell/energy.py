@@ -10,10 +10,20 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ._kernels import material_hessian_blocks, scatter_blocks
 from .kinematics import strain_hessian_contract, strain_jacobian, strains
 from .model import Shell, surface_derivatives
 
 _CHUNK = 8192
+
+
+def _dof_map(D: np.ndarray) -> np.ndarray:
+    """dy/dx for y = (a1, a2, a11, a22, a12): (f, q, 15, 3S) from basis derivatives D (f, q, S, 5)."""
+    nf, nq, S, _ = D.shape
+    B = np.zeros((nf, nq, 5, 3, S, 3))
+    for a in range(3):
+        B[:, :, :, a, :, a] = np.swapaxes(D, -1, -2)
+    return B.reshape(nf, nq, 15, 3 * S)
 
 
 class BlockPattern:
@@ -41,16 +51,13 @@ class BlockPattern:
 
     def assemble(self, group_blocks: list[list[tuple[np.ndarray, np.ndarray]]]) -> sp.csr_matrix:
         """Sum element blocks into a CSR matrix; ``group_blocks[g]`` lists (face_slice, blocks
-        (nf, S, 3, S, 3)) chunks in face order."""
+        (nf, S, S, 3, 3)) chunks in face order."""
         data = np.zeros((self.nnzb, 3, 3))
         for gi, chunks in enumerate(group_blocks):
             m = self.maps[gi]
             for sl, blk in chunks:
                 S = blk.shape[1]
-                idx = m[sl.start * S * S: sl.stop * S * S]
-                vals = blk.transpose(0, 1, 3, 2, 4).reshape(-1, 9)
-                for c in range(9):
-                    data[:, c // 3, c % 3] += np.bincount(idx, weights=vals[:, c], minlength=self.nnzb)
+                scatter_blocks(data, m[sl.start * S * S: sl.stop * S * S], blk)
         K = sp.bsr_matrix((data, self.cols, self.indptr), shape=(3 * self.n, 3 * self.n))
         return K.tocsr()
 
@@ -86,15 +93,19 @@ class ShellEnergy:
         if order == 0:
             return (w * W).sum()
         D = np.broadcast_to(np.concatenate([dN, ddN], axis=-1), (len(st),) + dN.shape[1:3] + (5,))
-        J = strain_jacobian(y)                                            # (f, q, 6, 5, 3)
-        gy = np.einsum("fqi,fqika->fqka", dW * w[..., None], J)
-        ge = np.einsum("fqsk,fqka->fsa", D, gy)
+        nf, nq, S = D.shape[:3]
+        J = strain_jacobian(y)                                            # (f, q, 6, 5, 3) ds/dy
+        dstride = 0 if dN.shape[0] == 1 else 1
+        Dc = np.concatenate([dN, ddN], axis=-1)                           # (f|1, q, S, 5)
+        ge = np.einsum("fqi,fqiKa,fqsK->fsa", dW * w[..., None], J, D, optimize=True)
         if order == 1:
             return (w * W).sum(), ge
-        Hy = np.einsum("fqiKa,fqij,fqjLb->fqKaLb", J, ddW * w[..., None, None], J, optimize=True)
-        if np.any(dW):
-            Hy += strain_hessian_contract(y, dW * w[..., None])
-        He = np.einsum("fqsK,fqKaLb,fqtL->fsatb", D, Hy, D, optimize=True)
+        He = material_hessian_blocks(np.ascontiguousarray(Dc), J, ddW * w[..., None, None], dstride)   # [f, s, t, a, b]
+        if np.any(dW):                                                    # geometric (stress) part
+            B = _dof_map(D)
+            Hg = strain_hessian_contract(y, dW * w[..., None]).reshape(nf, nq, 15, 15)
+            Hgeo = (np.swapaxes(B, -1, -2) @ (Hg @ B)).sum(axis=1).reshape(nf, S, 3, S, 3)
+            He += Hgeo.transpose(0, 1, 3, 2, 4)
         return (w * W).sum(), ge, He
 
     def energy(self, x: np.ndarray) -> float:

@@ -1,0 +1,66 @@
+"""Compiled element kernels (numba).  Pure functions of arrays; the numpy reference path in
+``energy.py`` computes the same quantities and the tests compare the two."""
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+
+
+@nb.njit(cache=True, parallel=True, fastmath=False)
+def material_hessian_blocks(D, J, C, dstride):
+    """sum_q G_q^T C_q G_q per face with G = ds/dx, G[i, s, a] = sum_K D[s, K] J[i, K, a].
+
+    D : (nf|1, nq, S, 5) basis derivatives; J : (nf, nq, 6, 5, 3) ds/dy; C : (nf, nq, 6, 6)
+    weighted material tangent; ``dstride`` = 0 when D has a leading axis of 1 (shared), else 1.
+    Returns (nf, S, S, 3, 3) blocks [s, t, a, b]."""
+    nf, nq = J.shape[0], J.shape[1]
+    S = D.shape[2]
+    out = np.zeros((nf, S, S, 3, 3))
+    for f in nb.prange(nf):
+        df = f * dstride
+        G = np.empty((6, S, 3))
+        CG = np.empty((6, S, 3))
+        for q in range(nq):
+            for i in range(6):
+                for s in range(S):
+                    for a in range(3):
+                        acc = 0.0
+                        for K in range(5):
+                            acc += D[df, q, s, K] * J[f, q, i, K, a]
+                        G[i, s, a] = acc
+            for j in range(6):
+                for s in range(S):
+                    for a in range(3):
+                        acc = 0.0
+                        for i in range(6):
+                            acc += C[f, q, j, i] * G[i, s, a]
+                        CG[j, s, a] = acc
+            for s in range(S):
+                for t in range(s, S):
+                    for a in range(3):
+                        for b in range(3):
+                            acc = 0.0
+                            for i in range(6):
+                                acc += G[i, s, a] * CG[i, t, b]
+                            out[f, s, t, a, b] += acc
+        for s in range(S):
+            for t in range(s + 1, S):
+                for a in range(3):
+                    for b in range(3):
+                        out[f, t, s, b, a] = out[f, s, t, a, b]
+    return out
+
+
+@nb.njit(cache=True)
+def scatter_blocks(data, index, blocks):
+    """data[index[f*S*S + s*S + t]] += blocks[f, s, t] (sequential: no write races)."""
+    nf, S = blocks.shape[0], blocks.shape[1]
+    k = 0
+    for f in range(nf):
+        for s in range(S):
+            for t in range(S):
+                p = index[k]
+                for a in range(3):
+                    for b in range(3):
+                        data[p, a, b] += blocks[f, s, t, a, b]
+                k += 1
