@@ -127,6 +127,7 @@ def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: i
 
     Returns (C csr, labels list[str], points (m_pts, 3) collocation points for reporting)."""
     x = shell.rest_positions
+    xv = np.asarray(shell.vertices, dtype=float)          # the given geometry, for region predicates
     n = shell.n_control
     rows, cols, vals, labels = [], [], [], []
     m = 0
@@ -148,7 +149,7 @@ def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: i
             ab = mesh.boundary_edges
             if len(ab) == 0:
                 raise SupportError(f"support '{sup.name}': the surface has no boundary edges")
-            mask = np.asarray(sup.where(x[ab[:, 0]]), bool) & np.asarray(sup.where(x[ab[:, 1]]), bool)
+            mask = np.asarray(sup.where(xv[ab[:, 0]]), bool) & np.asarray(sup.where(xv[ab[:, 1]]), bool)
             if not mask.any():
                 raise SupportError(f"support '{sup.name}' ({sup.kind}): its region selects no boundary edge")
             any_edge = True
@@ -268,6 +269,7 @@ def nitsche_matrix(shell: Shell, supports: list, ev: SurfaceEvaluator, gamma: fl
     from ..shell.materials import plane_stress_tensor
 
     x = shell.rest_positions
+    xv = np.asarray(shell.vertices, dtype=float)
     mesh = shell.mesh
     mat = shell.material
     thick = np.broadcast_to(np.asarray(shell.thickness, float), (mesh.n_real_faces,))
@@ -278,7 +280,7 @@ def nitsche_matrix(shell: Shell, supports: list, ev: SurfaceEvaluator, gamma: fl
         if not isinstance(sup, EdgeSupport) or not sup.directions()[1]:
             continue
         ab = mesh.boundary_edges
-        mask = np.asarray(sup.where(x[ab[:, 0]]), bool) & np.asarray(sup.where(x[ab[:, 1]]), bool)
+        mask = np.asarray(sup.where(xv[ab[:, 0]]), bool) & np.asarray(sup.where(xv[ab[:, 1]]), bool)
         for e in np.flatnonzero(mask):
             a, b = ab[e]
             f = int(mesh.boundary_faces[e])

@@ -41,6 +41,14 @@ class Shell:
     material : LinearElastic (or any object with ``density``)
     thickness : float or (n_faces,) [m]
     n_quad : int   Gauss points per face (1, 3, 6 or 12).
+    interpolate : bool or None
+        Move the control points so that the limit surface passes through the given vertices.
+        Otherwise the vertices are the control points and the limit surface lies slightly inside
+        a convex mesh (by O(h^2): 0.36 % of the radius of a 2,562-vertex icosphere, which makes
+        the pressurised-sphere displacement 0.7 % low; interpolated: 0.07 %).  Default (None):
+        only closed meshes are interpolated -- on an open mesh the ghost extrapolation shapes the
+        limit surface at the edge, and interpolating there degraded the pinched hemisphere from
+        -0.14 % to -1.6 % (4,921 vertices).
     """
 
     vertices: np.ndarray
@@ -48,6 +56,7 @@ class Shell:
     material: LinearElastic
     thickness: float | np.ndarray
     n_quad: int = 3
+    interpolate: bool | None = None
     mesh: GhostedMesh = field(init=False, repr=False)
     basis: LoopBasis = field(init=False, repr=False)
     rest: tuple[RestGroup, ...] = field(init=False, repr=False)
@@ -59,6 +68,8 @@ class Shell:
         if not np.all(np.isfinite(t)) or np.any(t <= 0):
             raise ProblemError(f"thickness must be positive and finite, got {self.thickness!r}")
         mesh = add_ghost_layer(self.vertices, self.faces)
+        if self.interpolate or (self.interpolate is None and len(mesh.boundary_edges) == 0):
+            mesh = mesh.interpolating()
         basis = build_basis(mesh.faces, mesh.n_control, np.arange(mesh.n_real_faces), self.n_quad)
         rest = []
         for g in basis.groups:

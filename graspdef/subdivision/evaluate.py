@@ -56,6 +56,18 @@ class SurfaceEvaluator:
         return w @ x[st]
 
 
+def _inside(vw: np.ndarray, margin: float = 1e-10) -> np.ndarray:
+    """Clamp a chart point into the triangle, ``margin`` away from its corners (an exact corner
+    may be an extraordinary vertex, where derivatives are not defined)."""
+    vw = np.clip(vw, 0.0, 1.0)
+    if vw.sum() > 1.0:
+        vw = vw / vw.sum()
+    u = 1.0 - vw.sum()
+    if max(u, vw[0], vw[1]) > 1.0 - margin:
+        vw = (1.0 - 3.0 * margin) * vw + margin
+    return vw
+
+
 def project_point(ev: SurfaceEvaluator, x: np.ndarray, target: np.ndarray, candidates: np.ndarray,
                   iterations: int = 12) -> tuple[int, np.ndarray, float]:
     """Closest point of the limit surface (control points ``x``) to ``target`` among the
@@ -72,10 +84,7 @@ def project_point(ev: SurfaceEvaluator, x: np.ndarray, target: np.ndarray, candi
             r = N[0] @ X - p
             A = dN[0].T @ X                                  # (2, 3): a1, a2
             step = np.linalg.lstsq(A @ A.T, -(A @ r), rcond=None)[0]
-            vw = vw + step
-            vw = np.clip(vw, 0.0, 1.0)
-            if vw.sum() > 1.0:
-                vw = vw / vw.sum()
+            vw = _inside(vw + step)
             if np.linalg.norm(step) < 1e-13:
                 break
         bary = np.array([1.0 - vw.sum(), vw[0], vw[1]])

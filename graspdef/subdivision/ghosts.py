@@ -14,7 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
 from ..errors import MeshError
+from .rules import limit_matrix
 
 
 @dataclass(frozen=True)
@@ -29,6 +33,7 @@ class GhostedMesh:
     n_real_faces : int
     boundary_edges : (n_ghost, 2)   directed boundary edges a -> b (real face on the left).
     boundary_faces : (n_ghost,)     the real face owning each boundary edge.
+    boundary_opposite : (n_ghost,)  the vertex of that face opposite the edge.
     """
 
     vertices: np.ndarray
@@ -38,9 +43,34 @@ class GhostedMesh:
     boundary_edges: np.ndarray
     boundary_faces: np.ndarray
 
+    boundary_opposite: np.ndarray | None = None
+
     @property
     def n_control(self) -> int:
         return len(self.vertices)
+
+    def extension(self) -> sp.csr_matrix:
+        """(n_control, n_real) map from real to all control points: ghosts are a + b - c."""
+        ng = len(self.boundary_edges)
+        g = np.arange(ng)
+        rows = np.concatenate([np.arange(self.n_real), self.n_real + np.repeat(g, 3)])
+        cols = np.concatenate([np.arange(self.n_real),
+                               np.stack([self.boundary_edges[:, 0], self.boundary_edges[:, 1],
+                                         self.boundary_opposite], 1).ravel()])
+        vals = np.concatenate([np.ones(self.n_real), np.tile([1.0, 1.0, -1.0], ng)])
+        return sp.csr_matrix((vals, (rows, cols)), shape=(self.n_control, self.n_real))
+
+    def interpolating(self) -> "GhostedMesh":
+        """The same mesh with control points moved so that the limit surface passes through the
+        original real vertices (limit point of vertex i = vertices[i]); ghosts re-extrapolated.
+
+        Solves the sparse, diagonally dominant system L E X = P (Loop limit masks L)."""
+        E = self.extension()
+        L = limit_matrix(self.faces, self.n_control, np.arange(self.n_real))
+        A = (L @ E).tocsc()
+        X = spla.splu(A).solve(self.vertices[: self.n_real])
+        return GhostedMesh(E @ X, self.faces, self.n_real, self.n_real_faces, self.boundary_edges,
+                           self.boundary_faces, self.boundary_opposite)
 
 
 def add_ghost_layer(vertices: np.ndarray, faces: np.ndarray) -> GhostedMesh:
@@ -62,7 +92,7 @@ def add_ghost_layer(vertices: np.ndarray, faces: np.ndarray) -> GhostedMesh:
     ba, bb, bc, bf = a[bnd], b[bnd], c[bnd], owner[bnd]
     ng = len(ba)
     if ng == 0:
-        return GhostedMesh(x, f, nv, nf, np.zeros((0, 2), np.int64), np.zeros(0, np.int64))
+        return GhostedMesh(x, f, nv, nf, np.zeros((0, 2), np.int64), np.zeros(0, np.int64), np.zeros(0, np.int64))
     ghost_ids = nv + np.arange(ng)
     ghost_x = x[ba] + x[bb] - x[bc]
     ghost_faces = np.stack([bb, ba, ghost_ids], axis=1)
@@ -84,4 +114,5 @@ def add_ghost_layer(vertices: np.ndarray, faces: np.ndarray) -> GhostedMesh:
         n_real_faces=nf,
         boundary_edges=np.stack([ba, bb], axis=1),
         boundary_faces=bf,
+        boundary_opposite=bc,
     )
