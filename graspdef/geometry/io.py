@@ -107,7 +107,8 @@ def save_ply(path: str | PathLike, vertices: np.ndarray, faces: np.ndarray, *,
     faces : ndarray, shape (m, 3), int
         Triangles, written as ``property list uchar int vertex_indices``.
     units : str
-        Length unit of the written coordinates, a key of :data:`LENGTH_UNITS`.
+        Length unit of the written coordinates, a key of :data:`LENGTH_UNITS`, or
+        ``"consistent"`` for a self-consistent unit set (coordinates written as given).
     vertex_scalars : mapping of str to ndarray of shape (n,), optional
         Extra per-vertex ``double`` properties (e.g. ``{"displacement": |u|}``), written as
         given (no unit conversion).  Names must be identifiers other than x, y, z.
@@ -119,7 +120,7 @@ def save_ply(path: str | PathLike, vertices: np.ndarray, faces: np.ndarray, *,
     ProblemError
         For unknown units, wrongly shaped arrays or invalid scalar names.
     """
-    scale = length_scale(units)
+    scale = 1.0 if units == "consistent" else length_scale(units)
     vertices = np.asarray(vertices, dtype=np.float64)
     faces = np.asarray(faces)
     if vertices.ndim != 2 or vertices.shape[1] != 3:

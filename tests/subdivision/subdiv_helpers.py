@@ -1,0 +1,177 @@
+"""Meshes and checks shared by the subdivision tests (imported by name: pytest puts this folder on
+sys.path).  Nothing here calls graspdef except ``loop_refine``, which only chains ``rules.refine``."""
+from __future__ import annotations
+
+import numpy as np
+
+from graspdef.subdivision.rules import refine
+
+#: An FD error below this fraction of the derivative's magnitude is indistinguishable from the
+#: round-off of the difference quotient (eps / h ~ 1e-13 for h ~ 1e-3) plus the h^4 term; above it
+#: the O(h^2) truncation error of a central difference dominates and must drop by 4 when h halves.
+FD_FLOOR = 1e-7
+
+
+def assert_fd_rate(exact, fd_h, fd_h2, scale=None, floor=FD_FLOOR, what="derivative"):
+    """Central differences at steps h and h/2 against an analytic derivative.
+
+    Every entry either agrees to ``floor * scale`` at h/2, or its error drops by a factor in
+    (3, 5) when h is halved (the O(h^2) truncation error of a central difference: factor 4).
+    A wrong derivative leaves an h-independent error (factor ~1) and fails.
+    """
+    exact = np.asarray(exact, float)
+    e1 = np.abs(np.asarray(fd_h) - exact)
+    e2 = np.abs(np.asarray(fd_h2) - exact)
+    if scale is None:
+        scale = max(np.abs(exact).max(), 1e-300)
+    small = e2 <= floor * scale
+    ratio = e1[~small] / e2[~small]
+    bad = (ratio < 3.0) | (ratio > 5.0)
+    assert not bad.any(), (
+        f"{what}: {bad.sum()} of {ratio.size} entries above the round-off floor do not converge "
+        f"at O(h^2): ratios {np.sort(ratio[bad])[:8]}, errors {np.sort(e2[~small][bad])[-4:]} "
+        f"(scale {scale:.3e})")
+    return e2.max() / scale
+
+
+def bipyramid(n: int, rng=None, jitter: float = 0.0):
+    """Closed double cone: ``n`` equator vertices (valence 4) and two poles of valence ``n``.
+
+    Vertices 0..n-1 on the unit circle, ``n`` = north pole (z = 1), ``n+1`` = south pole.  Each
+    face lists its pole first, so in the chart of face ``f`` the pole is at (0, 0).  Faces
+    0..n-1 hold the north pole (face i = (N, e_i, e_i+1)), faces n..2n-1 the south pole.
+    """
+    t = 2.0 * np.pi * np.arange(n) / n
+    eq = np.stack([np.cos(t), np.sin(t), np.zeros(n)], axis=1)
+    x = np.vstack([eq, [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]])
+    i = np.arange(n)
+    j = (i + 1) % n
+    north = np.stack([np.full(n, n), i, j], axis=1)
+    south = np.stack([np.full(n, n + 1), j, i], axis=1)
+    if rng is not None and jitter > 0:
+        x = x + jitter * rng.standard_normal(x.shape)
+    return x, np.vstack([north, south]).astype(np.int64)
+
+
+def torus(nu: int, nv: int, R: float = 2.0, r: float = 0.7):
+    """Closed torus triangulated as a doubly periodic grid: every vertex has valence 6."""
+    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="xy")
+    u = 2 * np.pi * i.ravel() / nu
+    v = 2 * np.pi * j.ravel() / nv
+    x = np.stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)], 1)
+    v00 = (i + j * nu).ravel()
+    v10 = ((i + 1) % nu + j * nu).ravel()
+    v01 = (i + ((j + 1) % nv) * nu).ravel()
+    v11 = ((i + 1) % nu + ((j + 1) % nv) * nu).ravel()
+    f = np.concatenate([np.stack([v00, v10, v11], 1), np.stack([v00, v11, v01], 1)])
+    return x, f.astype(np.int64)
+
+
+def random_flips(x, faces, rng, n_flips: int, min_valence: int = 3):
+    """Topologically valid random edge flips of a closed oriented mesh (valences spread out).
+
+    A flip of edge a-b between faces (a, b, c) and (b, a, d) gives (a, d, c) and (d, b, c); it is
+    skipped if c-d already is an edge or a or b would drop below ``min_valence``."""
+    f = np.array(faces, dtype=np.int64)
+    nv = len(x)
+    for _ in range(n_flips):
+        fi = int(rng.integers(len(f)))
+        k = int(rng.integers(3))
+        a, b, c = f[fi, k], f[fi, (k + 1) % 3], f[fi, (k + 2) % 3]
+        # face with the directed edge b -> a
+        rolled = [np.roll(f, -s, axis=1) for s in range(3)]
+        hit = None
+        for s, r in enumerate(rolled):
+            m = np.flatnonzero((r[:, 0] == b) & (r[:, 1] == a))
+            if len(m):
+                hit = (int(m[0]), s)
+                break
+        assert hit is not None, "mesh is not closed"
+        gi = hit[0]
+        d = int(rolled[hit[1]][gi, 2])
+        if c == d:
+            continue
+        val = np.bincount(_edges(f).ravel(), minlength=nv)
+        if val[a] - 1 < min_valence or val[b] - 1 < min_valence:
+            continue
+        e = _edges(f)
+        if ((e[:, 0] == min(c, d)) & (e[:, 1] == max(c, d))).any():
+            continue
+        f[fi] = (a, d, c)
+        f[gi] = (d, b, c)
+    return f
+
+
+def _edges(f):
+    pairs = np.sort(np.stack([f.ravel(), np.roll(f, -1, axis=1).ravel()], 1), axis=1)
+    return np.unique(pairs, axis=0)
+
+
+def valences(faces, nv):
+    return np.bincount(_edges(np.asarray(faces)).ravel(), minlength=nv)
+
+
+def loop_refine(x, faces, levels: int):
+    """Control points and faces after ``levels`` Loop steps (``rules.refine`` chained)."""
+    x = np.asarray(x, float)
+    f = np.asarray(faces, np.int64)
+    for _ in range(levels):
+        S, f = refine(f, len(x))
+        x = S @ x
+    return x, f
+
+
+# chart corners (v, w) of the four children of a face, in the child numbering of ``rules.refine``
+# (child k = 4 f + k): corners at parent vertex 0, 1, 2 and the centre triangle.
+_CHILD_CORNERS = np.array([
+    [[0.0, 0.0], [0.5, 0.0], [0.0, 0.5]],
+    [[0.5, 0.0], [1.0, 0.0], [0.5, 0.5]],
+    [[0.0, 0.5], [0.5, 0.5], [0.0, 1.0]],
+    [[0.5, 0.5], [0.0, 0.5], [0.5, 0.0]],
+])
+_CORNERS = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+
+
+def refinement_chain(x, faces, levels: int):
+    """Lists [x_0 .. x_levels], [faces_0 .. faces_levels] of successive Loop refinements."""
+    xs = [np.asarray(x, float)]
+    fs = [np.asarray(faces, np.int64)]
+    for _ in range(levels):
+        S, f = refine(fs[-1], len(xs[-1]))
+        xs.append(S @ xs[-1])
+        fs.append(f)
+    return xs, fs
+
+
+def dyadic_vertex(fs, face: int, point):
+    """Level and index of the control vertex that sits at chart point ``point`` of ``face`` of
+    ``fs[0]``, where ``fs`` are the face arrays of successive refinements (``refinement_chain``).
+    Child k of face f is face 4 f + k of the next level (``rules.refine``).  Independent of
+    ``basis._child_coords``: the child holding the point is found by barycentric coordinates from
+    the corner table above."""
+    p = np.asarray(point, float)
+    cur = int(face)
+    for level in range(len(fs)):
+        hit = np.flatnonzero(np.abs(_CORNERS - p).sum(1) < 1e-12)
+        if len(hit):
+            return level, int(fs[level][cur, hit[0]])
+        for k in range(4):
+            P = _CHILD_CORNERS[k]
+            T = np.column_stack([P[1] - P[0], P[2] - P[0]])
+            loc = np.linalg.solve(T, p - P[0])
+            if loc.min() >= -1e-14 and loc.sum() <= 1 + 1e-14:
+                cur, p = 4 * cur + k, loc
+                break
+        else:
+            raise AssertionError("point outside the reference triangle")
+    raise AssertionError(f"chart point is not a vertex after {len(fs) - 1} refinements")
+
+
+def edge_chart(face_vertices, a: int, b: int, t):
+    """Chart points (v, w) in a face of the points (1-t) a + t b along its edge a-b."""
+    fv = list(np.asarray(face_vertices))
+    t = np.atleast_1d(np.asarray(t, float))
+    bary = np.zeros((len(t), 3))
+    bary[:, fv.index(a)] = 1.0 - t
+    bary[:, fv.index(b)] = t
+    return bary[:, 1:3]
