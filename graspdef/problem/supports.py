@@ -2,9 +2,13 @@
 
 Each supported boundary edge contributes collocation points (Gauss-Legendre along the edge's
 limit curve).  At each point the limit displacement ``u = sum N_i u_i`` is constrained in the
-support's directions; with two points per edge this makes the constrained components vanish
-identically along the whole limit boundary curve (dependent rows are dropped, see
-``independent_rows``).  The constraints are imposed by Lagrange multipliers (``graspdef.solve``);
+support's directions at two Gauss points per edge (the default).  Between the points the
+residual is small and falls fast with refinement (measured on a simply supported plate: at most
+8e-4 of the maximum displacement on the edges next to a corner and 1.3e-5 elsewhere at 8 x 8
+cells, 1.8e-5 and 1.6e-7 at 32 x 32: order 3-4).  Three points per edge make the constraint
+hold identically along the whole limit curve, but then the corners lock (the same plate: 12 %
+too stiff at 8 x 8, 5 % at 16 x 16, against 0.01 % with two points), so two it is.  Dependent
+rows (closed loops) are dropped (``independent_rows``).  The constraints are imposed by Lagrange multipliers (``graspdef.solve``);
 ghost control vertices stay free, so natural boundary conditions come out of the energy.
 
 The rotation about the edge (``clamped``, ``symmetry``) is imposed by Nitsche's method
@@ -221,9 +225,9 @@ def check_rigid_modes(C: sp.csr_matrix, x: np.ndarray, rtol: float = 1e-8) -> No
 def independent_rows(C: sp.csr_matrix, rtol: float = 1e-9, dense_row: int = 10_000) -> np.ndarray:
     """Indices of a maximal linearly independent subset of the rows of C.
 
-    Collocation on a closed boundary loop is exactly rank-deficient (the limit curve's spline
-    space has one dimension less than two points per edge), so dependent rows are dropped by a
-    pivoted QR on each connected cluster of rows that share columns.  Rows with more than
+    Collocation with more points than the limit curve's spline space has dimensions is exactly
+    rank-deficient, so dependent rows are dropped by a pivoted QR on each connected cluster of
+    rows that share columns.  Rows with more than
     ``dense_row`` non-zeros (rigid-mode rows) are kept as they are."""
     from scipy.linalg import qr
     from scipy.sparse.csgraph import connected_components

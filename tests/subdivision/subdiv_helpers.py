@@ -73,32 +73,31 @@ def random_flips(x, faces, rng, n_flips: int, min_valence: int = 3):
     A flip of edge a-b between faces (a, b, c) and (b, a, d) gives (a, d, c) and (d, b, c); it is
     skipped if c-d already is an edge or a or b would drop below ``min_valence``."""
     f = np.array(faces, dtype=np.int64)
-    nv = len(x)
+    owner = {}                                   # directed edge -> face
+    for fi, (a, b, c) in enumerate(f.tolist()):
+        owner[a, b] = owner[b, c] = owner[c, a] = fi
+    val = np.bincount(_edges(f).ravel(), minlength=len(x))
     for _ in range(n_flips):
         fi = int(rng.integers(len(f)))
         k = int(rng.integers(3))
-        a, b, c = f[fi, k], f[fi, (k + 1) % 3], f[fi, (k + 2) % 3]
-        # face with the directed edge b -> a
-        rolled = [np.roll(f, -s, axis=1) for s in range(3)]
-        hit = None
-        for s, r in enumerate(rolled):
-            m = np.flatnonzero((r[:, 0] == b) & (r[:, 1] == a))
-            if len(m):
-                hit = (int(m[0]), s)
-                break
-        assert hit is not None, "mesh is not closed"
-        gi = hit[0]
-        d = int(rolled[hit[1]][gi, 2])
-        if c == d:
+        a, b, c = (int(f[fi, (k + s) % 3]) for s in range(3))
+        gi = owner[b, a]
+        d = next(int(v) for v in f[gi] if v != a and v != b)
+        if c == d or (c, d) in owner or (d, c) in owner:
             continue
-        val = np.bincount(_edges(f).ravel(), minlength=nv)
         if val[a] - 1 < min_valence or val[b] - 1 < min_valence:
             continue
-        e = _edges(f)
-        if ((e[:, 0] == min(c, d)) & (e[:, 1] == max(c, d))).any():
-            continue
+        for e in ((a, b), (b, c), (c, a), (b, a), (a, d), (d, b)):
+            del owner[e]
         f[fi] = (a, d, c)
         f[gi] = (d, b, c)
+        for g in (fi, gi):
+            p, q, r = (int(v) for v in f[g])
+            owner[p, q] = owner[q, r] = owner[r, p] = g
+        val[a] -= 1
+        val[b] -= 1
+        val[c] += 1
+        val[d] += 1
     return f
 
 

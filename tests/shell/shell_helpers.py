@@ -1,0 +1,57 @@
+"""Shared checks for the shell tests (imported by name: pytest puts this folder on sys.path)."""
+from __future__ import annotations
+
+import numpy as np
+
+#: An FD error below this fraction of the derivative's magnitude is indistinguishable from the
+#: round-off of the difference quotient (eps / h ~ 1e-13 for h ~ 1e-3) plus the O(h^4) term;
+#: above it the O(h^2) truncation error of a central difference dominates and must drop by a
+#: factor 4 when h halves.
+FD_FLOOR = 1e-7
+
+
+def assert_fd_rate(exact, fd_h, fd_h2, scale=None, floor=FD_FLOOR, what="derivative"):
+    """Central differences at steps h and h/2 against an analytic derivative.
+
+    Every entry either agrees to ``floor * scale`` at h/2, or its error drops by a factor in
+    (3, 5) when h is halved (O(h^2) truncation of a central difference: factor 4).  A wrong
+    derivative leaves an h-independent error (factor ~1) and fails.  Returns the largest
+    relative error at h/2 and the number of entries that went through the ratio test."""
+    exact = np.asarray(exact, float)
+    e1 = np.abs(np.asarray(fd_h) - exact)
+    e2 = np.abs(np.asarray(fd_h2) - exact)
+    if scale is None:
+        scale = max(np.abs(exact).max(), 1e-300)
+    small = e2 <= floor * scale
+    ratio = e1[~small] / e2[~small]
+    bad = (ratio < 3.0) | (ratio > 5.0)
+    assert not bad.any(), (
+        f"{what}: {bad.sum()} of {ratio.size} entries above the round-off floor do not converge "
+        f"at O(h^2): ratios {np.sort(ratio[bad])[:8]}, errors {np.sort(e2[~small][bad])[-4:]} "
+        f"(scale {scale:.3e})")
+    return e2.max() / scale, int(ratio.size)
+
+
+def random_rotation(rng):
+    """Uniformly random proper rotation (QR of a Gaussian matrix, sign-fixed)."""
+    q, r = np.linalg.qr(rng.standard_normal((3, 3)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q
+
+
+def rigid_modes(x):
+    """(3n, 6) infinitesimal rigid motions of points x (n, 3): three translations and the
+    rotations omega x x about the three axes."""
+    n = len(x)
+    modes = []
+    for k in range(3):
+        u = np.zeros((n, 3))
+        u[:, k] = 1.0
+        modes.append(u.ravel())
+    for k in range(3):
+        w = np.zeros(3)
+        w[k] = 1.0
+        modes.append(np.cross(w, x).ravel())
+    return np.array(modes).T
