@@ -1,0 +1,154 @@
+"""The command line: a run folder for a good problem file, and for every kind of bad input one
+clear error naming the problem and where, exit status 2, and no output files."""
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from graspdef.cli import main
+
+BASE = """
+name = "small_plate"
+[units]
+length = "mm"
+force = "N"
+[geometry]
+type = "rectangle"
+lx = 100.0
+ly = 100.0
+nx = 6
+ny = 6
+[material]
+E = 1000.0
+nu = 0.3
+[shell]
+thickness = 1.0
+[regions]
+edges = "abs(abs(x) - 50) < 1e-6 or abs(abs(y) - 50) < 1e-6"
+[[supports]]
+kind = "simply_supported"
+region = "edges"
+[[loads]]
+kind = "point"
+at = [0.0, 0.0, 0.0]
+force = [0.0, 0.0, -1.0]
+[[probes]]
+name = "centre"
+at = [0.0, 0.0, 0.0]
+"""
+
+
+def _run(tmp_path: Path, text: str, capsys, name="p.toml"):
+    f = tmp_path / name
+    f.write_text(text)
+    out = tmp_path / "run"
+    code = main(["-q", "solve", str(f), "--out", str(out)])
+    err = capsys.readouterr().err
+    return code, err, out
+
+
+def test_solve_writes_run_folder_in_file_units(tmp_path, capsys):
+    """Units are converted at I/O only: E = 1000 N/mm^2 = 1 GPa, the plate is 100 mm wide; the
+    centre deflection in mm follows Timoshenko's 0.0116 P a^2 / D within the coarse-mesh error."""
+    code, err, out = _run(tmp_path, BASE, capsys)
+    assert code == 0, err
+    rec = json.loads((out / "result.json").read_text())
+    assert rec["units"]["length"] == "mm"
+    w = rec["probes"]["centre"]["displacement"][2]
+    D = 1000.0 * 1.0 ** 3 / (12 * (1 - 0.09))           # N mm
+    assert w == pytest.approx(-0.0116008 * 1.0 * 100.0 ** 2 / D, rel=0.02)
+    assert rec["max_displacement"] == pytest.approx(abs(w), rel=1e-3)
+    assert rec["n_control"] == 49
+    assert set(rec["timings"]) >= {"assembly", "factor", "solve"}
+    head = (out / "deformed.ply").read_bytes()[:300]
+    assert b"comment units mm" in head
+    assert (out / "problem.toml").read_text() == BASE
+
+
+BAD = {
+    "missing units": (BASE.replace('[units]\nlength = "mm"\nforce = "N"\n', ""), "missing [units]"),
+    "misspelled key": (BASE.replace("thickness = 1.0", "thicknes = 1.0"), "did you mean 'thickness'"),
+    "unknown section": (BASE + "\n[solvr]\nbackend = 'auto'\n", "unknown key 'solvr'"),
+    "unknown length unit": (BASE.replace('length = "mm"', 'length = "furlong"'), "unknown length unit"),
+    "zero thickness": (BASE.replace("thickness = 1.0", "thickness = 0.0"), "thickness must be positive"),
+    "negative modulus": (BASE.replace("E = 1000.0", "E = -5.0"), "Young's modulus"),
+    "nu above 0.5": (BASE.replace("nu = 0.3", "nu = 0.6"), "Poisson's ratio"),
+    "nu negative": (BASE.replace("nu = 0.3", "nu = -0.1"), "Poisson's ratio"),
+    "NaN": (BASE.replace("E = 1000.0", "E = nan"), "must be finite"),
+    "probe off surface": (BASE.replace('name = "centre"\nat = [0.0, 0.0, 0.0]', 'name = "centre"\nat = [0.0, 0.0, 30.0]'),
+                          "off the surface"),
+    "under-supported": (BASE.replace('kind = "simply_supported"', 'kind = "symmetry"\nnormal = [1.0, 0.0, 0.0]'),
+                        "under-supported"),
+    "unknown region": (BASE.replace('region = "edges"', 'region = "edgs"'), "did you mean 'edges'"),
+    "bad support kind": (BASE.replace('kind = "simply_supported"', 'kind = "simply_suported"'), "did you mean 'simply_supported'"),
+    "bad region expression": (BASE.replace("abs(abs(x) - 50)", "__import__('os')"), "region 'edges'"),
+    "not toml": ("this is = = not toml", "not valid TOML"),
+    "missing mesh file": (BASE.replace('type = "rectangle"\nlx = 100.0\nly = 100.0\nnx = 6\nny = 6',
+                                       'type = "mesh"\npath = "nowhere.ply"\nunits = "mm"'), "not found"),
+    "mesh without units": (BASE.replace('type = "rectangle"\nlx = 100.0\nly = 100.0\nnx = 6\nny = 6',
+                                        'type = "mesh"\npath = "m.ply"'), "needs 'units'"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD), ids=list(BAD))
+def test_bad_problem_file_is_one_clear_error(tmp_path, capsys, case):
+    text, message = BAD[case]
+    code, err, out = _run(tmp_path, text, capsys)
+    assert code == 2
+    assert err.startswith("graspdef: error:") and err.count("\n") == 1, err
+    assert message in err, err
+    assert not out.exists()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".run")]
+
+
+def test_missing_problem_file(tmp_path, capsys):
+    code = main(["-q", "solve", str(tmp_path / "none.toml"), "--out", str(tmp_path / "o")])
+    assert code == 2
+    assert "problem file not found" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+def _write_obj(path: Path, vertices, faces):
+    lines = [f"v {x} {y} {z}" for x, y, z in vertices] + ["f " + " ".join(str(i + 1) for i in f) for f in faces]
+    path.write_text("\n".join(lines) + "\n")
+
+
+MESH_GEOM = 'type = "mesh"\npath = "m.obj"\nunits = "mm"'
+RECT = 'type = "rectangle"\nlx = 100.0\nly = 100.0\nnx = 6\nny = 6'
+
+
+@pytest.mark.parametrize("case,vertices,faces,message", [
+    ("non-manifold edge", [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, -1, 0], [1, 1, 1]],
+     [[0, 1, 2], [1, 0, 3], [0, 1, 4]], "non-manifold"),
+    ("degenerate face", [[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]], [[0, 1, 2], [0, 2, 3]], "degenerate"),
+    ("quads", [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]], "triangles"),
+])
+def test_bad_mesh_file(tmp_path, capsys, case, vertices, faces, message):
+    _write_obj(tmp_path / "m.obj", np.array(vertices, float) * 50, faces)
+    code, err, out = _run(tmp_path, BASE.replace(RECT, MESH_GEOM), capsys)
+    assert code == 2
+    assert message in err, err
+    assert not out.exists()
+
+
+def test_mesh_file_in_millimetres_is_converted(tmp_path, capsys):
+    """The same plate read from an OBJ in mm gives the same answer as the built-in rectangle."""
+    from graspdef.geometry import rectangle
+
+    m = rectangle(100.0, 100.0, 6, 6)
+    _write_obj(tmp_path / "m.obj", m.vertices, m.faces)
+    code, err, out = _run(tmp_path, BASE.replace(RECT, MESH_GEOM), capsys)
+    assert code == 0, err
+    w_mesh = json.loads((out / "result.json").read_text())["probes"]["centre"]["displacement"][2]
+    code, err, out2 = _run(tmp_path, BASE, capsys, name="q.toml")
+    w_rect = json.loads((out2 / "result.json").read_text())["probes"]["centre"]["displacement"][2]
+    assert w_mesh == pytest.approx(w_rect, rel=1e-10)
+
+
+def test_help_lists_subcommands(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--help"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    assert "solve" in out and "bench" in out
