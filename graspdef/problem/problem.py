@@ -21,16 +21,13 @@ class SurfacePoint:
     bary: tuple[float, float, float]
 
 
-def make_evaluator(shell: Shell) -> SurfaceEvaluator:
-    return SurfaceEvaluator(shell.mesh.faces, shell.n_control)
-
-
-def locate(shell: Shell, ev: SurfaceEvaluator, point, name: str, tol: float | None = None,
+def locate(shell: Shell, ev: SurfaceEvaluator | None, point, name: str = "point", tol: float | None = None,
            n_candidates: int = 8) -> tuple[SurfacePoint, float]:
     """Closest limit-surface point to ``point`` [m].
 
     Raises ProblemError when it is farther than ``tol`` (default: half the mean edge length of
     the control mesh) -- a probe or load off the surface."""
+    ev = shell.evaluator if ev is None else ev
     p = np.asarray(point, dtype=float)
     if p.shape != (3,) or not np.all(np.isfinite(p)):
         raise ProblemError(f"{name}: position must be three finite numbers, got {point!r}")
@@ -69,7 +66,7 @@ class Problem:
     n_collocation: int = 2
 
     def __post_init__(self) -> None:
-        self.evaluator = make_evaluator(self.shell)
+        self.evaluator = self.shell.evaluator
         n_real = self.shell.mesh.n_real_faces
         for ld in self.loads:
             if isinstance(ld, PointLoad) and not (0 <= ld.face < n_real):
@@ -79,6 +76,10 @@ class Problem:
                 raise ProblemError(f"probe '{name}' on face {sp_.face}: the mesh has faces 0..{n_real - 1}")
         if not self.supports:
             raise ProblemError("no supports: add supports, or RigidModes for a body held only by loads")
+
+    def locate(self, point, name: str = "point", tol: float | None = None) -> SurfacePoint:
+        """Closest limit-surface point to ``point`` [m] (see :func:`locate`)."""
+        return locate(self.shell, self.evaluator, point, name, tol)[0]
 
     def load_vector(self) -> np.ndarray:
         """External force vector (3 n_control,) [N]."""

@@ -7,6 +7,7 @@ import numpy as np
 
 from ..errors import ProblemError
 from ..subdivision.basis import LoopBasis, build_basis
+from ..subdivision.evaluate import SurfaceEvaluator
 from ..subdivision.ghosts import GhostedMesh, add_ghost_layer
 from .kinematics import fundamental_forms, normal
 from .materials import LinearElastic
@@ -87,6 +88,15 @@ class Shell:
     @property
     def n_control(self) -> int:
         return self.mesh.n_control
+
+    @property
+    def evaluator(self) -> SurfaceEvaluator:
+        """Limit-surface evaluation at any (face, point) of this shell's control mesh (cached)."""
+        ev = self.__dict__.get("_evaluator")
+        if ev is None:
+            ev = SurfaceEvaluator(self.mesh.faces, self.mesh.n_control)
+            object.__setattr__(self, "_evaluator", ev)
+        return ev
 
     @property
     def n_dofs(self) -> int:
