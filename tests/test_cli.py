@@ -152,3 +152,22 @@ def test_help_lists_subcommands(capsys):
     assert exc.value.code == 0
     out = capsys.readouterr().out
     assert "solve" in out and "bench" in out
+
+
+def test_point_load_by_face_and_barycentric_position(tmp_path, capsys):
+    """A load given as (face, bary) at the plate centre equals the one given by position: the
+    6 x 6 rectangle's centre is a vertex; the limit point there is the same whichever of its
+    faces names it."""
+    from graspdef.geometry import rectangle
+
+    m = rectangle(100.0, 100.0, 6, 6)
+    centre = int(np.argmin(np.linalg.norm(m.vertices, axis=1)))
+    face = int(np.flatnonzero((m.faces == centre).any(axis=1))[0])
+    bary = [1.0 if v == centre else 0.0 for v in m.faces[face]]
+    text = BASE.replace('kind = "point"\nat = [0.0, 0.0, 0.0]', f'kind = "point"\nface = {face}\nbary = {bary}')
+    code, err, out = _run(tmp_path, text, capsys)
+    assert code == 0, err
+    w_fb = json.loads((out / "result.json").read_text())["probes"]["centre"]["displacement"][2]
+    code, err, out2 = _run(tmp_path, BASE, capsys, name="q.toml")
+    w_at = json.loads((out2 / "result.json").read_text())["probes"]["centre"]["displacement"][2]
+    assert w_fb == pytest.approx(w_at, rel=1e-9)

@@ -201,10 +201,19 @@ def load_problem(path: str | Path) -> ProblemSpec:
         f = compile_predicate(expr, name, length_scale=1.0, atol=1e-9 * max(1.0, float(np.abs(mesh.vertices).max()) / ls))
         preds[name] = (lambda pts, f=f: f(pts / ls))
 
-    problem0 = Problem(shell, [], [RigidModes()])        # evaluator for locating points
-    ev = problem0.evaluator
+    ev = shell.evaluator
 
     def surface_point(entry: dict, ctx: str) -> SurfacePoint:
+        if ("at" in entry) == ("face" in entry):
+            raise ProblemError(_where(sp_, f"[{ctx}] give either 'at' (a position) or 'face' and 'bary'"))
+        if "face" in entry:
+            face = _integer(entry["face"], "face", ctx, sp_)
+            bary = _vector(entry.get("bary"), "bary", ctx, sp_)
+            if not (0 <= face < len(shell.faces)):
+                raise ProblemError(_where(sp_, f"[{ctx}] face {face} does not exist (the mesh has {len(shell.faces)} faces)"))
+            if np.any(bary < -1e-12) or abs(bary.sum() - 1.0) > 1e-9:
+                raise ProblemError(_where(sp_, f"[{ctx}] bary must be non-negative and sum to 1, got {bary.tolist()}"))
+            return SurfacePoint(face, tuple(float(b) for b in bary))
         at = _vector(entry["at"], "at", ctx, sp_) * ls
         tol = entry.get("tolerance")
         tol = None if tol is None else _number(tol, "tolerance", ctx, sp_) * ls
@@ -228,7 +237,7 @@ def load_problem(path: str | Path) -> ProblemSpec:
             _check_keys(s, {"kind", "name"}, ctx, sp_)
             supports.append(RigidModes())
         elif kind == "point":
-            _check_keys(s, {"kind", "name", "at", "directions", "tolerance"}, ctx, sp_, {"at"})
+            _check_keys(s, {"kind", "name", "at", "face", "bary", "directions", "tolerance"}, ctx, sp_)
             dirs = s.get("directions", [[1, 0, 0], [0, 1, 0], [0, 0, 1]])
             if not isinstance(dirs, list) or not dirs:
                 raise ProblemError(_where(sp_, f"[{ctx}] directions must be a list of 3-vectors"))
@@ -252,7 +261,7 @@ def load_problem(path: str | Path) -> ProblemSpec:
         ctx = f"loads {i + 1}"
         kind = ld.get("kind") if isinstance(ld, dict) else None
         if kind == "point":
-            _check_keys(ld, {"kind", "at", "force", "tolerance"}, ctx, sp_, {"at", "force"})
+            _check_keys(ld, {"kind", "at", "face", "bary", "force", "tolerance"}, ctx, sp_, {"force"})
             pt = surface_point(ld, ctx)
             loads.append(PointLoad(pt.face, pt.bary, tuple(_vector(ld["force"], "force", ctx, sp_) * fs)))
         elif kind == "pressure":
@@ -276,7 +285,7 @@ def load_problem(path: str | Path) -> ProblemSpec:
     probes = {}
     for i, pr in enumerate(doc.get("probes", [])):
         ctx = f"probes {i + 1}"
-        _check_keys(pr, {"name", "at", "tolerance"}, ctx, sp_, {"name", "at"})
+        _check_keys(pr, {"name", "at", "face", "bary", "tolerance"}, ctx, sp_, {"name"})
         if pr["name"] in probes:
             raise ProblemError(_where(sp_, f"[{ctx}] duplicate probe name {pr['name']!r}"))
         probes[pr["name"]] = surface_point(pr, f"probe '{pr['name']}'")

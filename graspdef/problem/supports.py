@@ -188,6 +188,7 @@ def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: i
         return sp.csr_matrix((0, 3 * n)), labels
     C = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(m, 3 * n))
     C.sum_duplicates()
+    C.eliminate_zeros()          # structural zeros would merge independent clusters
     return C, labels
 
 
@@ -248,7 +249,7 @@ def independent_rows(C: sp.csr_matrix, rtol: float = 1e-9, dense_row: int = 10_0
         sub = Cs[rows]
         cols = np.unique(sub.indices)
         A = sub[:, cols].toarray()
-        _, R, piv = qr(A.T, mode="economic", pivoting=True)
+        R, piv = qr(A.T, mode="r", pivoting=True)
         diag = np.abs(np.diag(R))
         rank = int((diag > rtol * diag[0]).sum()) if len(diag) else 0
         keep.append(sparse_rows[rows[np.sort(piv[:rank])]])

@@ -11,7 +11,7 @@ from graspdef.subdivision.evaluate import SurfaceEvaluator
 from graspdef.subdivision.ghosts import add_ghost_layer
 from graspdef.subdivision.halfedge import interior_mask
 from graspdef.subdivision.quadrature import triangle_rule
-from graspdef.subdivision.rules import limit_matrix, mesh_edges
+from graspdef.subdivision.rules import limit_matrix
 from subdiv_helpers import edge_chart, valences
 
 OPEN = {
@@ -150,8 +150,10 @@ def test_flat_plate_limit_surface_is_the_plate(rotate):
         A, B, C = (x[m.faces[grp.faces, k]] for k in range(3))
         expect = A[:, None] + qp[None, :, 0:1] * (B - A)[:, None] + qp[None, :, 1:2] * (C - A)[:, None]
         np.testing.assert_allclose(P, expect, rtol=0, atol=1e-14)
-        np.testing.assert_allclose(d1[:, :, 0], np.broadcast_to((B - A)[:, None], d1[:, :, 0].shape), rtol=0, atol=1e-13)
-        np.testing.assert_allclose(d1[:, :, 1], np.broadcast_to((C - A)[:, None], d1[:, :, 1].shape), rtol=0, atol=1e-13)
+        np.testing.assert_allclose(d1[:, :, 0], np.broadcast_to((B - A)[:, None], P.shape),
+                                   rtol=0, atol=1e-13)
+        np.testing.assert_allclose(d1[:, :, 1], np.broadcast_to((C - A)[:, None], P.shape),
+                                   rtol=0, atol=1e-13)
         np.testing.assert_allclose(d2, 0.0, rtol=0, atol=1e-12)
         height = (P - x[0]) @ R[:, 2]               # distance from the plate's plane
         np.testing.assert_allclose(height, 0.0, rtol=0, atol=1e-14)
