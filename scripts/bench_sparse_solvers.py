@@ -86,9 +86,9 @@ SOLVERS = [
     ("qdldl-regularised", "kkt", "qdldl", {}),
     ("pardiso-spd", "spd", "pypardiso", {}),
     ("cholmod", "spd", "sksparse.cholmod", {}),
+    ("mumps-spd", "spd", "mumps", {}),
     ("cholmod-refblas", "spd", "sksparse.cholmod", {"LD_LIBRARY_PATH": ":".join(REF_BLAS_DIRS)}),
     ("cholespy", "spd", "cholespy", {}),
-    ("mumps-spd", "spd", "mumps", {}),
     ("superlu-mmd_at_plus_a-spd", "spd", "scipy", {}),
     ("qdldl-spd", "spd", "qdldl", {}),
 ]
@@ -476,6 +476,9 @@ def main() -> None:
     ap.add_argument("--repeats-large", type=int, default=1, help="runs per solver above 50k vertices")
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per solver run")
     ap.add_argument("--solvers", nargs="+", default=None, help="subset of: " + " ".join(s[0] for s in SOLVERS))
+    ap.add_argument("--skip", nargs="+", default=[], help="solvers to report as skipped")
+    ap.add_argument("--reuse-build", action="store_true",
+                    help="reuse matrices and assembly timings of an earlier run from out/bench_sparse_cache")
     ap.add_argument("--out", default="out/bench_sparse_solvers.json")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--system", help=argparse.SUPPRESS)
@@ -497,8 +500,10 @@ def main() -> None:
     out_path.parent.mkdir(parents=True, exist_ok=True)
     env_info = {"python": platform.python_version(), "cpus": os.cpu_count(), "loadavg_start": os.getloadavg(),
                 "machine": platform.machine(), "date": time.strftime("%Y-%m-%d %H:%M:%S")}
-    skip_reason = {name: _available(mod, extra) for name, _, mod, extra in solvers}
-    timed_out: dict[str, str] = {}
+    skip_reason = {name: "--skip" if name in args.skip else _available(mod, extra)
+                   for name, _, mod, extra in solvers}
+    timed_out: dict[str, str] = {}           # solvers not tried again at larger sizes, and why
+    previous: dict[str, tuple[int, float]] = {}   # solver -> (n_dofs, median total) at a smaller size
     records, builds = [], []
     md = [f"# Sparse solver benchmark ({env_info['date']}, {env_info['cpus']} CPUs, "
           f"load average at start {env_info['loadavg_start'][0]:.2f})", ""]
@@ -508,10 +513,13 @@ def main() -> None:
 
     for nz in args.sizes:
         case_dir = CACHE / f"nz{nz}"
-        print(f"[n_z={nz}] building ...", file=sys.stderr, flush=True)
-        meta, err = _spawn(["--build", str(nz), "--case", str(case_dir)], timeout=3600)
-        if meta is None:
-            raise SystemExit(f"building n_z={nz} failed: {err}")
+        if args.reuse_build and (case_dir / "meta.json").exists():
+            meta = json.loads((case_dir / "meta.json").read_text())
+        else:
+            print(f"[n_z={nz}] building ...", file=sys.stderr, flush=True)
+            meta, err = _spawn(["--build", str(nz), "--case", str(case_dir)], timeout=3600)
+            if meta is None:
+                raise SystemExit(f"building n_z={nz} failed: {err}")
         builds.append(meta)
         large = meta["n_vertices"] > LARGE_VERTICES
         repeats = args.repeats_large if large else args.repeats
@@ -520,6 +528,11 @@ def main() -> None:
             base = {"size": nz, "n_vertices": meta["n_vertices"], "n_dofs": meta["n_dofs"], "solver": name,
                     "system": system}
             reason = skip_reason[name] or timed_out.get(name, "")
+            if not reason and name in previous:   # a direct factorisation of a surface mesh: ~ n^1.5
+                n0, t0 = previous[name]
+                guess = t0 * (meta["n_dofs"] / n0) ** 1.5
+                if guess > args.timeout:
+                    reason = f"predicted {guess:.0f} s (> timeout) from {t0:.1f} s at {n0:,} DOFs, time ~ n^1.5"
             if reason:
                 rec = {**base, "status": "skipped: " + reason, "runs": 0}
                 records.append(rec), size_recs.append(rec)
@@ -553,6 +566,8 @@ def main() -> None:
                 if status == "ok" and rec["residual"] is not None and rec["residual"] > 1e-8:
                     rec["status"] = f"inaccurate (residual {rec['residual']:.1e})"
             records.append(rec), size_recs.append(rec)
+            if rec.get("total_s") is not None:
+                previous[name] = (meta["n_dofs"], rec["total_s"])
             save()
 
         # agreement of the solutions with the reference solver of each system

@@ -184,8 +184,8 @@ def load_problem(path: str | Path) -> ProblemSpec:
     if thickness <= 0:
         raise ProblemError(_where(sp_, f"[shell] thickness must be positive, got {thickness}"))
     nq = _integer(sh.get("quadrature", 3), "quadrature", "shell", sp_)
-    if nq not in (1, 3, 6, 12):
-        raise ProblemError(_where(sp_, f"[shell] quadrature must be 1, 3, 6 or 12 points, got {nq}"))
+    if nq not in (3, 6, 12):
+        raise ProblemError(_where(sp_, f"[shell] quadrature must be 3, 6 or 12 points per face, got {nq}"))
     interp = doc["geometry"].get("interpolate")
     if interp is not None and not isinstance(interp, bool):
         raise ProblemError(_where(sp_, "[geometry] interpolate must be true or false"))

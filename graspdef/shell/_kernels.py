@@ -11,7 +11,8 @@ def material_hessian_blocks(D, J, C, dstride):
     """sum_q G_q^T C_q G_q per face with G = ds/dx, G[i, s, a] = sum_K D[s, K] J[i, K, a].
 
     D : (nf|1, nq, S, 5) basis derivatives; J : (nf, nq, 6, 5, 3) ds/dy; C : (nf, nq, 6, 6)
-    weighted material tangent; ``dstride`` = 0 when D has a leading axis of 1 (shared), else 1.
+    weighted material tangent, which must be symmetric (a Hessian of the energy density; only
+    the upper triangle of each 36x36 block is computed and mirrored); ``dstride`` = 0 when D has a leading axis of 1 (shared), else 1.
     Returns (nf, S, S, 3, 3) blocks [s, t, a, b]."""
     nf, nq = J.shape[0], J.shape[1]
     S = D.shape[2]

@@ -41,7 +41,7 @@ class Shell:
     faces : (n_faces, 3) int, oriented
     material : LinearElastic (or any object with ``density``)
     thickness : float or (n_faces,) [m]
-    n_quad : int   Gauss points per face (1, 3, 6 or 12).
+    n_quad : int   Gauss points per face (3, 6 or 12; one point leaves spurious zero-energy modes).
     interpolate : bool or None
         Move the control points so that the limit surface passes through the given vertices.
         Otherwise the vertices are the control points and the limit surface lies slightly inside
@@ -68,6 +68,9 @@ class Shell:
             raise ProblemError("thickness must be a number or one value per face")
         if not np.all(np.isfinite(t)) or np.any(t <= 0):
             raise ProblemError(f"thickness must be positive and finite, got {self.thickness!r}")
+        if self.n_quad not in (3, 6, 12):
+            raise ProblemError(f"n_quad must be 3, 6 or 12 Gauss points per face, got {self.n_quad} "
+                               "(one point leaves spurious zero-energy modes)")
         mesh = add_ghost_layer(self.vertices, self.faces)
         if self.interpolate or (self.interpolate is None and len(mesh.boundary_edges) == 0):
             mesh = mesh.interpolating()

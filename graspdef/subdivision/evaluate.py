@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import MeshError
+
 from .basis import _is_regular, irregular_basis, regular_stencils, vertex_faces
 from .halfedge import HalfEdges, face_counts, interior_mask
 from .patch import regular_basis
@@ -29,6 +31,8 @@ class SurfaceEvaluator:
     def basis(self, face: int, pts: np.ndarray):
         """Stencil (S,), N (q, S), dN (q, S, 2), ddN (q, S, 3) at chart points ``pts`` (q, 2)."""
         tri = self.faces[face]
+        if not self._inner[tri].all():
+            raise MeshError(f"face {face} has a vertex with an open one-ring: evaluate the ghosted mesh")
         pts = np.atleast_2d(np.asarray(pts, dtype=float))
         if _is_regular(tri[None], self._counts, self._inner)[0]:
             N, dN, ddN = regular_basis(pts)
@@ -42,6 +46,8 @@ class SurfaceEvaluator:
         corner = np.flatnonzero(b > 1.0 - tol)
         if len(corner):
             vtx = int(self.faces[face][corner[0]])
+            if not self._inner[vtx]:
+                raise MeshError(f"vertex {vtx} has an open one-ring: evaluate the ghosted mesh")
             nbrs = np.unique(self.faces[self._vf[vtx].indices])
             nbrs = nbrs[nbrs != vtx]
             chi = float(limit_weight(len(nbrs)))

@@ -91,7 +91,8 @@ def refine(faces: np.ndarray, n_vertices: int) -> tuple[sp.csr_matrix, np.ndarra
     rows += [ei, ej]
     cols += [ej, ei]
     vals += [beta[ei], beta[ej]]
-    centre = np.where(inner, 1.0 - val * beta, 0.75)
+    used = np.bincount(f.ravel(), minlength=nv) > 0
+    centre = np.where(inner, 1.0 - val * beta, np.where(used, 0.75, 1.0))   # unused vertices stay put
     rows.append(np.arange(nv))
     cols.append(np.arange(nv))
     vals.append(centre)

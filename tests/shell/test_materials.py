@@ -112,3 +112,18 @@ def test_density_derivatives():
     assert np.linalg.eigvalsh(D).min() > 0
     np.testing.assert_allclose(dW, D @ s, rtol=1e-14)
     assert W == pytest.approx(0.5 * s @ D @ s, rel=1e-14)
+
+
+def test_one_point_quadrature_is_refused():
+    """One Gauss point per face leaves spurious zero-energy modes (8 instead of 6 zero
+    eigenvalues on a ghosted 6 x 4 rectangle), so Shell refuses it."""
+    import pytest as _pytest
+
+    from graspdef.errors import ProblemError
+    from graspdef.geometry import rectangle
+    from graspdef.shell.materials import LinearElastic
+    from graspdef.shell.model import Shell
+
+    m = rectangle(1.0, 1.0, 4, 4)
+    with _pytest.raises(ProblemError, match="zero-energy"):
+        Shell(m.vertices, m.faces, LinearElastic(1.0, 0.3), 0.01, n_quad=1)
