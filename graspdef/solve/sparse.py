@@ -47,26 +47,30 @@ def pardiso_available() -> bool:
     return True
 
 
+def constraint_scale(K: sp.spmatrix) -> float:
+    """Scale of C in the KKT matrix: the mean |diagonal| of K (balances the two blocks)."""
+    d = np.abs(K.diagonal())
+    return float(d[d > 0].mean()) if np.any(d > 0) else 1.0
+
+
 def kkt_matrix(K: sp.spmatrix, C: sp.spmatrix) -> tuple[sp.csr_matrix, float]:
     """Full symmetric KKT matrix with C scaled to the size of K's diagonal; returns (A, scale)."""
-    d = np.abs(K.diagonal())
-    scale = float(d[d > 0].mean()) if np.any(d > 0) else 1.0
+    scale = constraint_scale(K)
     A = sp.bmat([[K, scale * C.T], [scale * C, None]], format="csr")
     return A, scale
 
 
-def _upper_with_diagonal(A: sp.csr_matrix) -> sp.csr_matrix:
-    U = sp.triu(A, format="coo")
-    n = A.shape[0]
-    r = np.concatenate([U.row, np.arange(n)])
-    c = np.concatenate([U.col, np.arange(n)])
-    v = np.concatenate([U.data, np.zeros(n)])
-    out = sp.coo_matrix((v, (r, c)), shape=A.shape).tocsr()   # keeps explicit zeros on the diagonal
-    out.sort_indices()
-    return out
+def kkt_upper(K: sp.spmatrix, C: sp.spmatrix, scale: float) -> sp.csr_matrix:
+    """Upper triangle of the KKT matrix with an explicit (zero) diagonal in the constraint block,
+    as PARDISO's symmetric modes want it; built without forming the full matrix."""
+    m = C.shape[0]
+    zero = sp.coo_matrix((np.zeros(m), (np.arange(m), np.arange(m))), shape=(m, m))
+    U = sp.bmat([[sp.triu(K, format="coo"), (scale * C.T).tocoo()], [None, zero]], format="csr")
+    U.sort_indices()
+    return U
 
 
-def _factor_pardiso(A: sp.csr_matrix, n_constraints: int):
+def _factor_pardiso(U: sp.csr_matrix):
     import pypardiso
 
     solver = pypardiso.PyPardisoSolver(mtype=-2)
@@ -77,7 +81,6 @@ def _factor_pardiso(A: sp.csr_matrix, n_constraints: int):
     solver.set_iparm(11, 1)     # symmetric scaling
     solver.set_iparm(13, 1)     # weighted matching (recommended for saddle-point systems)
     solver.set_iparm(21, 1)     # Bunch-Kaufman pivoting
-    U = _upper_with_diagonal(A)
     solver.factorize(U)
     perturbed = int(solver.get_iparm(14))
     n_neg = int(solver.get_iparm(23))
@@ -92,12 +95,14 @@ def solve_kkt(K: sp.spmatrix, C: sp.spmatrix, f: np.ndarray, backend: str = "aut
     if backend == "auto":
         backend = "pardiso" if pardiso_available() else "superlu"
     n, m = K.shape[0], C.shape[0]
-    A, scale = kkt_matrix(K, C)
+    K = K.tocsr()
+    C = C.tocsr()
+    scale = constraint_scale(K)
     rhs = np.concatenate([f, np.zeros(m)])
     t0 = time.perf_counter()
     n_neg = None
     if backend == "pardiso":
-        solver, U, perturbed, n_neg = _factor_pardiso(A, m)
+        solver, U, perturbed, n_neg = _factor_pardiso(kkt_upper(K, C, scale))
         t1 = time.perf_counter()
         if n_neg != m:
             raise SupportError(
@@ -108,6 +113,7 @@ def solve_kkt(K: sp.spmatrix, C: sp.spmatrix, f: np.ndarray, backend: str = "aut
         sol = solver.solve(U, rhs)
         solver.free_memory(everything=True)
     else:
+        A, _ = kkt_matrix(K, C)
         try:
             lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A")
         except RuntimeError as exc:
@@ -117,10 +123,11 @@ def solve_kkt(K: sp.spmatrix, C: sp.spmatrix, f: np.ndarray, backend: str = "aut
     t2 = time.perf_counter()
     if not np.all(np.isfinite(sol)):
         raise SolverError("the linear solve produced non-finite values (singular system)")
-    res = A @ sol - rhs
+    u, lam = sol[:n], sol[n:]
+    res = np.concatenate([K @ u + scale * (C.T @ lam) - f, scale * (C @ u)])
     fn = max(np.linalg.norm(f), 1e-300)
     rel = float(np.linalg.norm(res) / fn)
     if rel > rtol:
         raise SolverError(f"linear solve residual {rel:.2e} exceeds {rtol:.0e} (ill-conditioned or singular)")
     log.info("KKT %s: n=%d m=%d factor %.3fs solve %.3fs residual %.1e", backend, n, m, t1 - t0, t2 - t1, rel)
-    return KKTResult(sol[:n], scale * sol[n:], backend, n_neg, t1 - t0, t2 - t1, rel)
+    return KKTResult(u, scale * lam, backend, n_neg, t1 - t0, t2 - t1, rel)
