@@ -53,8 +53,10 @@ def material_hessian_blocks(D, J, C, dstride):
 
 
 @nb.njit(cache=True)
-def scatter_blocks(data, index, blocks):
-    """data[index[f*S*S + s*S + t]] += blocks[f, s, t] (sequential: no write races)."""
+def scatter_blocks(data, index, blocks, base, stride):
+    """Add blocks[f, s, t] (3x3) into a scalar CSR ``data`` array: the block goes to block
+    position p = index[f*S*S + s*S + t], whose entry (a, b) lives at base[p] + a*stride[p] + b
+    (sequential: no write races)."""
     nf, S = blocks.shape[0], blocks.shape[1]
     k = 0
     for f in range(nf):
@@ -62,6 +64,7 @@ def scatter_blocks(data, index, blocks):
             for t in range(S):
                 p = index[k]
                 for a in range(3):
+                    q = base[p] + a * stride[p]
                     for b in range(3):
-                        data[p, a, b] += blocks[f, s, t, a, b]
+                        data[q + b] += blocks[f, s, t, a, b]
                 k += 1

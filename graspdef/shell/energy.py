@@ -31,35 +31,47 @@ class BlockPattern:
 
     def __init__(self, shell: Shell):
         n = shell.n_control
-        keys, self.maps = [], []
-        for g in shell.basis.groups:
-            st = g.stencils
-            keys.append((st[:, :, None] * n + st[:, None, :]).ravel())
-        allk = np.concatenate(keys)
-        uniq, inv = np.unique(allk, return_inverse=True)
-        off = 0
-        for k in keys:
-            self.maps.append(inv[off: off + len(k)])
-            off += len(k)
-        self.rows = uniq // n
-        self.cols = uniq % n
+        rows, cols, off = [], [], 0
+        for g in shell.basis.groups:                  # face-vertex incidence P; pattern = P P^T
+            rows.append(g.stencils.ravel())
+            cols.append(np.repeat(np.arange(off, off + len(g.stencils)), g.stencils.shape[1]))
+            off += len(g.stencils)
+        P = sp.csr_matrix((np.ones(sum(len(r) for r in rows), np.int32),
+                           (np.concatenate(rows), np.concatenate(cols))), shape=(n, off))
+        G = (P @ P.T).tocsr()
+        G.sort_indices()
+        self.indptr = G.indptr.astype(np.int64)
+        self.cols = G.indices.astype(np.int64)
+        keys = np.repeat(np.arange(n, dtype=np.int64), np.diff(self.indptr)) * n + self.cols
+        self.maps = [np.searchsorted(keys, (g.stencils[:, :, None] * n + g.stencils[:, None, :]).ravel())
+                     for g in shell.basis.groups]
         self.n = n
-        indptr = np.zeros(n + 1, np.int64)
-        np.add.at(indptr, self.rows + 1, 1)
-        self.indptr = np.cumsum(indptr)
-        self.nnzb = len(uniq)
+        self.nnzb = len(keys)
+        # scalar CSR of the 3x3-block pattern: block p (row r, k-th in its row, L blocks in the
+        # row) holds entry (a, b) at  9 indptr[r] + 3 L a + 3 k + b
+        row_len = np.diff(self.indptr)
+        rowof = np.repeat(np.arange(n), row_len)
+        k_in_row = np.arange(self.nnzb) - self.indptr[rowof]
+        self.base = 9 * self.indptr[rowof] + 3 * k_in_row
+        self.stride = 3 * row_len[rowof]
+        self.scalar_indptr = np.concatenate([[0], np.cumsum(np.repeat(3 * row_len, 3))]).astype(np.int64)
+        cols3 = (3 * self.cols[:, None] + np.arange(3)).reshape(-1)          # per block row, 3L columns
+        idx = np.empty(9 * self.nnzb, np.int64)
+        for a in range(3):
+            pos = (self.base[:, None] + a * self.stride[:, None] + np.arange(3)).ravel()
+            idx[pos] = cols3
+        self.scalar_indices = idx
 
     def assemble(self, group_blocks: list[list[tuple[np.ndarray, np.ndarray]]]) -> sp.csr_matrix:
         """Sum element blocks into a CSR matrix; ``group_blocks[g]`` lists (face_slice, blocks
         (nf, S, S, 3, 3)) chunks in face order."""
-        data = np.zeros((self.nnzb, 3, 3))
+        data = np.zeros(9 * self.nnzb)
         for gi, chunks in enumerate(group_blocks):
             m = self.maps[gi]
             for sl, blk in chunks:
                 S = blk.shape[1]
-                scatter_blocks(data, m[sl.start * S * S: sl.stop * S * S], blk)
-        K = sp.bsr_matrix((data, self.cols, self.indptr), shape=(3 * self.n, 3 * self.n))
-        return K.tocsr()
+                scatter_blocks(data, m[sl.start * S * S: sl.stop * S * S], blk, self.base, self.stride)
+        return sp.csr_matrix((data, self.scalar_indices, self.scalar_indptr), shape=(3 * self.n, 3 * self.n))
 
 
 class ShellEnergy:

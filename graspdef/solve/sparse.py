@@ -75,11 +75,11 @@ def _factor_pardiso(U: sp.csr_matrix):
 
     solver = pypardiso.PyPardisoSolver(mtype=-2)
     solver.set_iparm(1, 1)      # use the values below, not the defaults
-    solver.set_iparm(2, 2)      # METIS nested-dissection ordering
+    solver.set_iparm(2, 3)      # parallel METIS nested-dissection ordering
     solver.set_iparm(8, 2)      # up to two steps of iterative refinement
     solver.set_iparm(10, 8)     # pivot perturbation 1e-8 (then refined; the true residual is checked)
     solver.set_iparm(11, 1)     # symmetric scaling
-    solver.set_iparm(13, 1)     # weighted matching (recommended for saddle-point systems)
+    solver.set_iparm(13, 2)     # weighted matching, improved variant (saddle-point systems)
     solver.set_iparm(21, 1)     # Bunch-Kaufman pivoting
     solver.factorize(U)
     perturbed = int(solver.get_iparm(14))
