@@ -17,17 +17,20 @@ support at (0, R, L/2) that removes the last rigid mode), meshed with ``cylinder
 
 Solvers (each one is skipped, not crashed, if its package is missing):
 
-  kkt: ``pardiso`` (MKL PARDISO via pypardiso, mtype -2, the iparm settings of
-       ``graspdef.solve.sparse._factor_pardiso``; phases 11 / 22 / 33 timed separately),
+  kkt: ``pardiso`` (MKL PARDISO via pypardiso, mtype -2, the iparm settings that
+       ``graspdef.solve.sparse._factor_pardiso`` uses, read from it at run time; phases
+       11 / 22 / 33 timed separately),
        ``solve_kkt`` (the production ``graspdef.solve.sparse.solve_kkt`` end to end, including
        building the KKT matrix, its upper triangle and the residual check),
        ``superlu-colamd`` and ``superlu-mmd_at_plus_a`` (``scipy.sparse.linalg.splu``; its
        analysis is not separable, so it counts as factorisation), ``mumps`` (pymumps, sym = 2,
-       LDL^T with pivoting, jobs 1 / 2 / 3), ``qdldl`` (LDL^T without pivoting, AMD ordering).
+       LDL^T with pivoting, jobs 1 / 2 / 3), ``qdldl`` (LDL^T without pivoting, AMD ordering),
+       ``qdldl-regularised`` (zero block -> -1e-8 s I, then iterative refinement, as OSQP does).
   spd: ``cholespy`` (its bundled CHOLMOD; analysis + factorisation happen in one constructor),
        ``cholmod`` (scikit-sparse, the system's SuiteSparse and whatever BLAS ``libblas.so.3``
        resolves to), ``cholmod-refblas`` (the same with Debian's reference BLAS/LAPACK put first
-       on LD_LIBRARY_PATH, if installed), ``pardiso-spd`` (mtype 2, METIS), ``mumps-spd``
+       on LD_LIBRARY_PATH, if installed), ``pardiso-spd`` (mtype 2, the production ordering
+       option iparm(2), other values MKL's defaults), ``mumps-spd``
        (sym = 1), ``superlu-mmd_at_plus_a-spd``, ``qdldl-spd``.
 
 How
@@ -218,27 +221,56 @@ def load_case(case_dir: Path, system: str):
 # --------------------------------------------------------------------------------------------
 
 def _upper_csr(A):
-    from graspdef.solve.sparse import _upper_with_diagonal
+    """Upper triangle of a symmetric CSR matrix with an explicit (possibly zero) diagonal."""
+    import scipy.sparse as sp
 
-    return _upper_with_diagonal(A.tocsr())
+    U = sp.triu(A, k=1, format="coo")
+    n = A.shape[0]
+    out = sp.coo_matrix((np.concatenate([U.data, A.diagonal()]),
+                         (np.concatenate([U.row, np.arange(n)]), np.concatenate([U.col, np.arange(n)]))),
+                        shape=A.shape).tocsr()
+    out.sort_indices()
+    return out
+
+
+def project_pardiso_iparm() -> dict[int, int]:
+    """The iparm values (1-based index -> value) that ``graspdef.solve.sparse._factor_pardiso`` sets.
+
+    Read by running it on a 2x2 matrix with ``PyPardisoSolver.factorize`` stubbed out, so the
+    benchmark follows the production settings when they change."""
+    import inspect
+
+    import pypardiso
+    import scipy.sparse as sp
+    from graspdef.solve import sparse as gs
+
+    seen = {}
+    original = pypardiso.PyPardisoSolver.factorize
+    pypardiso.PyPardisoSolver.factorize = lambda self, A: seen.update(iparm=self.iparm.copy())
+    try:
+        U = sp.csr_matrix(np.array([[1.0, 1.0], [0.0, 0.0]]))
+        n_args = len(inspect.signature(gs._factor_pardiso).parameters)
+        gs._factor_pardiso(*[U, 1][:n_args])
+    finally:
+        pypardiso.PyPardisoSolver.factorize = original
+    return {i + 1: int(v) for i, v in enumerate(seen["iparm"]) if v and i != 11}   # iparm(12): set per call
 
 
 def _pardiso(mtype: int):
     def prepare(A, b, extra):
-        return _upper_csr(A)
+        return _upper_csr(A), project_pardiso_iparm()
 
-    def run(U, b):
+    def run(data, b):
         import pypardiso
 
+        U, project = data
         s = pypardiso.PyPardisoSolver(mtype=mtype)
-        s.set_iparm(1, 1)               # use the values below, not the defaults
-        s.set_iparm(2, 2)               # METIS nested dissection
-        if mtype == -2:                 # the settings of graspdef.solve.sparse._factor_pardiso
-            s.set_iparm(8, 2)
-            s.set_iparm(10, 8)
-            s.set_iparm(11, 1)
-            s.set_iparm(13, 1)
-            s.set_iparm(21, 1)
+        if mtype == -2:
+            settings = project                               # exactly the production settings
+        else:                                                # SPD: the production ordering only
+            settings = {1: 1, 2: project.get(2, 2)}
+        for i, v in settings.items():
+            s.set_iparm(i, v)
         s.set_iparm(18, -1)             # report nnz(L) (reporting only)
         s._check_A(U)
         bb = np.asfortranarray(b.reshape(-1, 1))
@@ -249,7 +281,7 @@ def _pardiso(mtype: int):
             x = s._call_pardiso(U, bb)
             tm[key] = time.perf_counter() - t
         tm.update(factor_nnz=int(s.get_iparm(18)), n_negative=int(s.get_iparm(23)),
-                  perturbed_pivots=int(s.get_iparm(14)), threads=int(s.get_iparm(3)) or None)
+                  perturbed_pivots=int(s.get_iparm(14)), iparm=" ".join(f"{i}:{v}" for i, v in settings.items()))
         s.free_memory(everything=True)
         return x.ravel(), tm
     return prepare, run
@@ -562,7 +594,7 @@ def main() -> None:
                            residual=max((x["residual"] for x in runs if x.get("residual") is not None), default=None),
                            u_A=last.get("u_A"), all_total_s=[x["total_s"] for x in runs],
                            **{k: last[k] for k in ("factor_nnz", "n_negative", "perturbed_pivots", "ordering",
-                                                    "threads", "refinement_steps") if last.get(k) is not None})
+                                                    "iparm", "refinement_steps") if last.get(k) is not None})
                 if status == "ok" and rec["residual"] is not None and rec["residual"] > 1e-8:
                     rec["status"] = f"inaccurate (residual {rec['residual']:.1e})"
             records.append(rec), size_recs.append(rec)
@@ -588,7 +620,8 @@ def main() -> None:
                "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
         for r in size_recs:
             notes = [] if r["status"] == "ok" else [r["status"]]
-            notes += [f"{k}={r[k]}" for k in ("ordering", "n_negative", "perturbed_pivots", "refinement_steps")
+            notes += [f"{k}={r[k]}" for k in ("ordering", "iparm", "n_negative", "perturbed_pivots",
+                                                   "refinement_steps")
                       if r.get(k) is not None]
             if r.get("end_to_end_s") is not None:
                 notes.append(f"end-to-end {r['end_to_end_s']:.3g} s")

@@ -38,6 +38,7 @@ import scipy.sparse as sp
 from ..errors import ProblemError, SupportError
 from ..shell.model import Shell
 from ..subdivision.evaluate import SurfaceEvaluator
+from ..subdivision.patch import regular_basis
 
 KINDS = ("free", "simply_supported", "clamped", "symmetry", "diaphragm")
 
@@ -157,17 +158,30 @@ def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: i
             if not mask.any():
                 raise SupportError(f"support '{sup.name}' ({sup.kind}): its region selects no boundary edge")
             any_edge = True
-            for e in np.flatnonzero(mask):
-                a, b = ab[e]
-                f = int(mesh.boundary_faces[e])
-                tri = mesh.faces[f]
-                i = int(np.flatnonzero(tri == a)[0])
-                j, k = (i + 1) % 3, (i + 2) % 3
-                pts = (1 - taus)[:, None] * _CORNERS[i] + taus[:, None] * _CORNERS[j]
-                st, N, dN, _ = ev.basis(f, pts)
-                for q in range(len(taus)):
+            edges = np.flatnonzero(mask)
+            faces = mesh.boundary_faces[edges]
+            corner = np.argmax(mesh.faces[faces] == ab[edges, 0][:, None], axis=1)   # edge a -> b starts here
+            pts = [(1 - taus)[:, None] * _CORNERS[i] + taus[:, None] * _CORNERS[(i + 1) % 3] for i in range(3)]
+            reg = ev.is_regular(faces)
+            if reg.any():                                   # box-spline patches: all at once
+                table = np.stack([regular_basis(p)[0] for p in pts])            # (3, q, 12)
+                st = ev.regular_stencils(faces[reg])                             # (R, 12)
+                W = table[corner[reg]]                                           # (R, q, 12)
+                R, q = W.shape[:2]
+                k = len(dirs)
+                v = W[:, :, None, :, None] * dirs[None, None, :, None, :]        # (R, q, k, 12, 3)
+                c = np.broadcast_to((3 * st[:, None, None, :, None] + np.arange(3)), v.shape)
+                r = m + np.arange(R * q * k).reshape(R, q, k, 1, 1)
+                rows.append(np.broadcast_to(r, v.shape).ravel())
+                cols.append(c.ravel())
+                vals.append(v.ravel())
+                labels += [f"{sup.name}: edge {a}-{b}" for a, b in ab[edges[reg]] for _ in range(q * k)]
+                m += R * q * k
+            for e, f, i in zip(edges[~reg], faces[~reg], corner[~reg]):
+                st, N, _, _ = ev.basis(int(f), pts[i])
+                for qq in range(len(taus)):
                     for d in dirs:
-                        add(st, N[q], d, f"{sup.name}: u.{np.round(d, 3).tolist()} at edge {a}-{b}")
+                        add(st, N[qq], d, f"{sup.name}: edge {ab[e, 0]}-{ab[e, 1]}")
         elif isinstance(sup, PointSupport):
             st, w = ev.values(sup.face, np.asarray(sup.bary, float))
             for d in np.asarray(sup.directions, dtype=float):

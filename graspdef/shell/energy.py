@@ -109,7 +109,10 @@ class ShellEnergy:
         J = strain_jacobian(y)                                            # (f, q, 6, 5, 3) ds/dy
         dstride = 0 if dN.shape[0] == 1 else 1
         Dc = np.concatenate([dN, ddN], axis=-1)                           # (f|1, q, S, 5)
-        ge = np.einsum("fqi,fqiKa,fqsK->fsa", dW * w[..., None], J, D, optimize=True)
+        if np.any(dW):
+            ge = np.einsum("fqi,fqiKa,fqsK->fsa", dW * w[..., None], J, D, optimize=True)
+        else:                                                             # at rest: no stress
+            ge = np.zeros((nf, S, 3))
         if order == 1:
             return (w * W).sum(), ge
         He = material_hessian_blocks(np.ascontiguousarray(Dc), J, ddW * w[..., None, None], dstride)   # [f, s, t, a, b]

@@ -28,6 +28,14 @@ class SurfaceEvaluator:
         self._counts = face_counts(self.faces, self.n_control)
         self._inner = interior_mask(self.faces, self.n_control)
 
+    def is_regular(self, faces: np.ndarray) -> np.ndarray:
+        """True for faces whose three vertices are interior with valence 6 (box-spline patches)."""
+        return _is_regular(self.faces[np.asarray(faces, dtype=np.int64)], self._counts, self._inner)
+
+    def regular_stencils(self, faces: np.ndarray) -> np.ndarray:
+        """12-vertex stencils (n, 12) of regular faces, in ``patch.LATTICE`` order."""
+        return regular_stencils(self._he, self.faces[np.asarray(faces, dtype=np.int64)])
+
     def basis(self, face: int, pts: np.ndarray):
         """Stencil (S,), N (q, S), dN (q, S, 2), ddN (q, S, 3) at chart points ``pts`` (q, 2)."""
         tri = self.faces[face]
