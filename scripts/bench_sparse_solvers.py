@@ -51,12 +51,20 @@ How
    relative difference of each solution to the reference solver's (``pardiso`` / ``pardiso-spd``).
 4. Times are medians over the runs (``--repeats`` for sizes below 50k vertices,
    ``--repeats-large`` above); a run that exceeds ``--timeout`` seconds is killed and reported,
-   and that solver is not tried at larger sizes.
+   and that solver is not tried at larger sizes.  A solver whose time at a smaller size,
+   scaled by (n_dofs ratio)^1.5, exceeds the timeout is skipped with that prediction as the
+   reason (measured here: the real growth from 10k to 100k vertices was 1.2-1.5x steeper).
+   The 1-minute load average at the start of each run is recorded: the machine has 2 cores.
 
 Usage::
 
     python scripts/bench_sparse_solvers.py [--sizes 70 224] [--repeats 3] [--repeats-large 1]
-        [--timeout 600] [--solvers pardiso mumps ...] [--out out/bench_sparse_solvers.json]
+        [--timeout 600] [--solvers pardiso mumps ...] [--skip superlu-colamd ...]
+        [--reuse-build] [--out out/bench_sparse_solvers.json]
+
+Optional packages: pypardiso (+ mkl), python-mumps is not usable on Python 3.11, so MUMPS is
+``pymumps`` built against Debian's ``libmumps-dev`` (+ ``mpi4py``); ``scikit-sparse==0.4.16``
+needs ``libsuitesparse-dev``; ``qdldl``; ``cholespy`` (bundles a reference BLAS).
 """
 from __future__ import annotations
 
@@ -644,7 +652,7 @@ def main() -> None:
     md += [f"- {name}: {blas or 'none'}" for name, blas in
            dict((r["solver"], r["blas"]) for r in records if "blas" in r).items()]
     md += ["", f"total = analysis + factor + solve (median; min total = fastest run); load = 1-minute load "
-           "average when the run started (2 CPUs: above ~1 means other work competed); wall = the whole timed call including imports and library/MPI "
+           "average when the run started (2 CPUs; a solver run itself brings it towards 2, more means other work competed); wall = the whole timed call including imports and library/MPI "
            f"start-up. Reference u_A (radial displacement at A) = {U_A_REFERENCE:.4e}; the spd system is a "
            "different (clamped-ring) problem. rel. diff = ||u - u_ref|| / ||u_ref|| against "
            f"{REFERENCE['kkt']} (kkt) and {REFERENCE['spd']} (spd).", "", f"JSON: {out_path}"]

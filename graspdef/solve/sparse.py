@@ -81,7 +81,10 @@ def _factor_pardiso(U: sp.csr_matrix):
     solver.set_iparm(11, 1)     # symmetric scaling
     solver.set_iparm(13, 2)     # weighted matching, improved variant (saddle-point systems)
     solver.set_iparm(21, 1)     # Bunch-Kaufman pivoting
-    solver.factorize(U)
+    # call the phases directly: pypardiso's factorize()/solve() copy and compare the matrix
+    solver._check_A(U)
+    solver.set_phase(12)                                    # analysis + numerical factorisation
+    solver._call_pardiso(U, np.zeros((U.shape[0], 1)))
     perturbed = int(solver.get_iparm(14))
     n_neg = int(solver.get_iparm(23))
     return solver, U, perturbed, n_neg
@@ -110,7 +113,8 @@ def solve_kkt(K: sp.spmatrix, C: sp.spmatrix, f: np.ndarray, backend: str = "aut
                 f"pivots for {m} constraints (expected {m}; {perturbed} pivots perturbed). A mechanism is "
                 "free (a part without supports, or redundant/conflicting supports).")
         log.info("PARDISO: %d perturbed pivots (removed by iterative refinement; residual checked)", perturbed)
-        sol = solver.solve(U, rhs)
+        solver.set_phase(33)                                # solve with iterative refinement
+        sol = solver._call_pardiso(U, np.asfortranarray(rhs))
         solver.free_memory(everything=True)
     else:
         A, _ = kkt_matrix(K, C)
