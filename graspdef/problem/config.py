@@ -24,7 +24,7 @@ from ..geometry.regions import compile_predicate
 from ..shell.materials import LinearElastic
 from ..shell.model import Shell
 from .loads import BodyForce, PointLoad, Pressure
-from .problem import Problem, SurfacePoint, locate
+from .problem import BACKENDS, Problem, SurfacePoint, locate
 from .supports import KINDS, EdgeSupport, PointSupport, RigidModes
 
 FORCE_UNITS = {"N": 1.0, "kN": 1e3, "mN": 1e-3}
@@ -293,7 +293,6 @@ def load_problem(path: str | Path) -> ProblemSpec:
     solver = doc.get("solver", {})
     _check_keys(solver, {"backend", "collocation"}, "solver", sp_)
     backend = solver.get("backend", "auto")
-    from ..solve.sparse import BACKENDS
     if backend not in BACKENDS:
         raise ProblemError(_where(sp_, f"[solver] unknown backend {backend!r} (valid: {', '.join(BACKENDS)})"))
     ncol = _integer(solver.get("collocation", 2), "collocation", "solver", sp_)

@@ -13,6 +13,10 @@ from .loads import PointLoad, load_vector
 from .supports import check_rigid_modes, constraint_rows, independent_rows, nitsche_matrix
 
 
+#: sparse solver back-ends a problem may ask for (graspdef.solve.sparse implements them)
+BACKENDS = ("auto", "pardiso", "superlu")
+
+
 @dataclass(frozen=True)
 class SurfacePoint:
     """A point of the limit surface: real face index and barycentric coordinates."""

@@ -36,6 +36,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import ProblemError, SupportError
+from ..shell.kinematics import strain_jacobian
+from ..shell.materials import plane_stress_tensor
 from ..shell.model import Shell
 from ..subdivision.evaluate import SurfaceEvaluator
 from ..subdivision.patch import regular_basis
@@ -284,9 +286,6 @@ def nitsche_matrix(shell: Shell, supports: list, ev: SurfaceEvaluator, gamma: fl
     plates e.g. Embar, Dolbow & Harari 2010).  ``gamma`` must make the form coercive; the solver's
     inertia check reports it if it does not.
     """
-    from ..shell.kinematics import strain_jacobian
-    from ..shell.materials import plane_stress_tensor
-
     x = shell.rest_positions
     xv = np.asarray(shell.vertices, dtype=float)
     mesh = shell.mesh
