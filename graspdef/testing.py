@@ -1,0 +1,32 @@
+"""Verification helpers shared by graspdef's tests and usable by anyone extending it (numpy only)."""
+from __future__ import annotations
+
+import numpy as np
+
+#: An FD error below this fraction of the derivative's magnitude is indistinguishable from the
+#: round-off of the difference quotient (eps / h ~ 1e-13 for h ~ 1e-3) plus the O(h^4) term;
+#: above it the O(h^2) truncation error of a central difference dominates and must drop by a
+#: factor 4 when h halves.
+FD_FLOOR = 1e-7
+
+
+def assert_fd_rate(exact, fd_h, fd_h2, scale=None, floor=FD_FLOOR, what="derivative"):
+    """Central differences at steps h and h/2 against an analytic derivative.
+
+    Every entry either agrees to ``floor * scale`` at h/2, or its error drops by a factor in
+    (3, 5) when h is halved (O(h^2) truncation of a central difference: factor 4).  A wrong
+    derivative leaves an h-independent error (factor ~1) and fails.  Returns the largest
+    relative error at h/2 and the number of entries that went through the ratio test."""
+    exact = np.asarray(exact, float)
+    e1 = np.abs(np.asarray(fd_h) - exact)
+    e2 = np.abs(np.asarray(fd_h2) - exact)
+    if scale is None:
+        scale = max(np.abs(exact).max(), 1e-300)
+    small = e2 <= floor * scale
+    ratio = e1[~small] / e2[~small]
+    bad = (ratio < 3.0) | (ratio > 5.0)
+    assert not bad.any(), (
+        f"{what}: {bad.sum()} of {ratio.size} entries above the round-off floor do not converge "
+        f"at O(h^2): ratios {np.sort(ratio[bad])[:8]}, errors {np.sort(e2[~small][bad])[-4:]} "
+        f"(scale {scale:.3e})")
+    return e2.max() / scale, int(ratio.size)
