@@ -1,12 +1,12 @@
 # graspdef: two commands on a fresh Debian/Ubuntu machine.
 #   make demo   set up (.venv, package, dependencies) and run the main job
-#   make test   set up, then run the test suite (slow tests excluded; `make test-slow` runs them)
+#   make test   set up, then run the test suite (tests marked `slow` are excluded)
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: setup demo test test-slow bench clean system-packages
+.PHONY: setup demo test clean system-packages
 
 # Debian packages the Python dependencies need at run time (installed when run as root).
 DEB_PACKAGES := libgomp1
@@ -31,9 +31,6 @@ demo: setup
 
 test: setup
 	$(PY) -m pytest -q -m "not slow"
-
-test-slow: setup
-	$(PY) -m pytest -q -m slow
 
 clean:
 	rm -rf $(VENV) out .pytest_cache
