@@ -204,8 +204,6 @@ def test_interpolating_limit_points_hit_the_vertices(name):
     of a diagonally dominant sparse solve)."""
     m = OPEN[name]()
     g = add_ghost_layer(m.vertices, m.faces)
-    if not hasattr(g, "interpolating"):
-        pytest.skip("GhostedMesh.interpolating not available")
     gi = g.interpolating()
     L = limit_matrix(gi.faces, gi.n_control, np.arange(gi.n_real))
     np.testing.assert_allclose(L @ gi.vertices, m.vertices, rtol=0, atol=1e-13)
