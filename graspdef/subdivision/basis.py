@@ -17,7 +17,7 @@ from ..errors import MeshError
 from .halfedge import HalfEdges, face_counts, interior_mask
 from .patch import regular_basis
 from .quadrature import triangle_rule
-from .rules import limit_weight, refine
+from .rules import refine
 
 _MAX_DEPTH = 48
 
