@@ -83,8 +83,11 @@ def _factor_pardiso(U: sp.csr_matrix):
     solver.set_iparm(21, 1)     # Bunch-Kaufman pivoting
     # call the phases directly: pypardiso's factorize()/solve() copy and compare the matrix
     solver._check_A(U)
-    solver.set_phase(12)                                    # analysis + numerical factorisation
-    solver._call_pardiso(U, np.zeros((U.shape[0], 1)))
+    z = np.zeros((U.shape[0], 1))
+    solver.set_phase(11)                                    # analysis (matching, ordering)
+    solver._call_pardiso(U, z)
+    solver.set_phase(22)                                    # numerical factorisation
+    solver._call_pardiso(U, z)
     perturbed = int(solver.get_iparm(14))
     n_neg = int(solver.get_iparm(23))
     return solver, U, perturbed, n_neg
