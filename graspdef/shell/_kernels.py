@@ -68,3 +68,26 @@ def scatter_blocks(data, index, blocks, base, stride):
                     for b in range(3):
                         data[q + b] += blocks[f, s, t, a, b]
                 k += 1
+
+
+@nb.njit(cache=True, parallel=True)
+def block_positions(stencils, indptr, cols):
+    """Position in the block-CSR pattern (indptr, cols; sorted columns) of every stencil pair
+    (stencils[f, s], stencils[f, t]), flattened in (f, s, t) order; binary search per row."""
+    nf, S = stencils.shape
+    out = np.empty(nf * S * S, np.int64)
+    for f in nb.prange(nf):
+        for s in range(S):
+            r = stencils[f, s]
+            lo0, hi0 = indptr[r], indptr[r + 1]
+            for t in range(S):
+                c = stencils[f, t]
+                lo, hi = lo0, hi0
+                while lo < hi:
+                    mid = (lo + hi) // 2
+                    if cols[mid] < c:
+                        lo = mid + 1
+                    else:
+                        hi = mid
+                out[(f * S + s) * S + t] = lo
+    return out

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ._kernels import material_hessian_blocks, scatter_blocks
+from ._kernels import block_positions, material_hessian_blocks, scatter_blocks
 from .kinematics import strain_hessian_contract, strain_jacobian, strains
 from .model import Shell, surface_derivatives
 
@@ -42,11 +42,10 @@ class BlockPattern:
         G.sort_indices()
         self.indptr = G.indptr.astype(np.int64)
         self.cols = G.indices.astype(np.int64)
-        keys = np.repeat(np.arange(n, dtype=np.int64), np.diff(self.indptr)) * n + self.cols
-        self.maps = [np.searchsorted(keys, (g.stencils[:, :, None] * n + g.stencils[:, None, :]).ravel())
+        self.maps = [block_positions(np.ascontiguousarray(g.stencils), self.indptr, self.cols)
                      for g in shell.basis.groups]
         self.n = n
-        self.nnzb = len(keys)
+        self.nnzb = len(self.cols)
         # scalar CSR of the 3x3-block pattern: block p (row r, k-th in its row, L blocks in the
         # row) holds entry (a, b) at  9 indptr[r] + 3 L a + 3 k + b
         row_len = np.diff(self.indptr)
