@@ -27,9 +27,17 @@ from ..problem.problem import BACKENDS
 log = logging.getLogger(__name__)
 
 
-
 @dataclass
 class KKTResult:
+    """Solution of the KKT system.
+
+    Attributes
+    ----------
+    u : (n,) displacements;  multipliers : (m,) constraint forces (Lagrange multipliers)
+    backend : "pardiso" or "superlu";  n_negative : negative pivots (PARDISO) or None
+    seconds_factor, seconds_solve : wall times;  residual : ||K u + C^T l - f|| / ||f||
+    """
+
     u: np.ndarray
     multipliers: np.ndarray
     backend: str
