@@ -49,7 +49,7 @@ class KKTResult:
 
 def pardiso_available() -> bool:
     try:
-        import pypardiso  # noqa: F401
+        import pypardiso  # noqa: F401  (availability probe)
     except Exception:       # ImportError, or mkl_rt missing
         return False
     return True
