@@ -51,7 +51,8 @@ for rep in range(repeats + 1):          # the first run warms caches (numba, imp
                  sup + [PointSupport(C.face, C.bary, ((0, 0, 1),))], {"A": A})
     t1 = time.perf_counter()
     _, _, K = ShellEnergy(sh).hessian(sh.rest_positions)
-    K = (K + pr.boundary_stiffness()).tocsr()
+    Kb = pr.boundary_stiffness()
+    K = (K + Kb).tocsr() if Kb.nnz else K
     f = pr.load_vector()
     Cm, _ = pr.constraints()
     t2 = time.perf_counter()

@@ -70,7 +70,9 @@ def solve_linear(problem: Problem, backend: str = "auto") -> LinearSolution:
     t0 = time.perf_counter()
     shell = problem.shell
     _, _, K = ShellEnergy(shell).hessian(shell.rest_positions)
-    K = (K + problem.boundary_stiffness()).tocsr()
+    Kb = problem.boundary_stiffness()
+    if Kb.nnz:
+        K = (K + Kb).tocsr()
     t1 = time.perf_counter()
     f = problem.load_vector()
     C, _ = problem.constraints()

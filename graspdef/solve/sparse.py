@@ -71,11 +71,29 @@ def kkt_matrix(K: sp.spmatrix, C: sp.spmatrix) -> tuple[sp.csr_matrix, float]:
 def kkt_upper(K: sp.spmatrix, C: sp.spmatrix, scale: float) -> sp.csr_matrix:
     """Upper triangle of the KKT matrix with an explicit (zero) diagonal in the constraint block,
     as PARDISO's symmetric modes want it; built without forming the full matrix."""
-    m = C.shape[0]
-    zero = sp.coo_matrix((np.zeros(m), (np.arange(m), np.arange(m))), shape=(m, m))
-    U = sp.bmat([[sp.triu(K, format="coo"), (scale * C.T).tocoo()], [None, zero]], format="csr")
-    U.sort_indices()
-    return U
+    K = K.tocsr()
+    n, m = K.shape[0], C.shape[0]
+    rows = np.repeat(np.arange(n), np.diff(K.indptr))
+    up = K.indices >= rows                                   # upper triangle of K, row by row
+    Ct = (scale * C.T).tocsr()
+    Ct.sort_indices()
+    # row i of U: K's upper entries, then C^T's entries (columns n..n+m); then m zero diagonals
+    cnt = np.bincount(rows[up], minlength=n) + np.diff(Ct.indptr)
+    indptr = np.concatenate([[0], np.cumsum(np.concatenate([cnt, np.ones(m, np.int64)]))])
+    indices = np.empty(indptr[-1], np.int64)
+    data = np.empty(indptr[-1])
+    ku = np.diff(np.concatenate([[0], np.cumsum(np.bincount(rows[up], minlength=n))]))
+    start = indptr[:n]
+    pos_k = start[rows[up]] + (np.arange(up.sum()) - np.repeat(np.cumsum(ku) - ku, ku))
+    indices[pos_k] = K.indices[up]
+    data[pos_k] = K.data[up]
+    crow = np.repeat(np.arange(n), np.diff(Ct.indptr))
+    pos_c = start[crow] + ku[crow] + (np.arange(Ct.nnz) - Ct.indptr[crow])
+    indices[pos_c] = n + Ct.indices
+    data[pos_c] = Ct.data
+    indices[indptr[n:-1]] = n + np.arange(m)
+    data[indptr[n:-1]] = 0.0
+    return sp.csr_matrix((data, indices, indptr), shape=(n + m, n + m))
 
 
 def _factor_pardiso(U: sp.csr_matrix):
