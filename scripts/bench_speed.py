@@ -6,7 +6,8 @@ several times; medians are reported:
 * set-up: control mesh, ghost layer, Loop basis at the quadrature points, rest geometry;
 * assembly: the Hessian at rest K (3x3-block sparse), the load vector and the support
   constraints C;
-* solve: KKT factorisation and solve (PARDISO symmetric indefinite by default);
+* solve: KKT factorisation and solve (PARDISO symmetric indefinite by default), as timed by
+  ``solve_linear``;
 * peak resident memory of the process (VmHWM).
 
 Targets (issue 2): 10,000 control vertices, assembly + solve <= 2 s; 100,000 control vertices
@@ -26,44 +27,23 @@ from pathlib import Path
 
 CHILD = r"""
 import json, sys, time
-import numpy as np
 n_z = int(sys.argv[1]); repeats = int(sys.argv[2])
-from graspdef.geometry import cylinder
-from graspdef.problem.loads import PointLoad
-from graspdef.problem.problem import Problem, locate
-from graspdef.problem.supports import EdgeSupport, PointSupport
-from graspdef.shell.energy import ShellEnergy
-from graspdef.shell.materials import LinearElastic
-from graspdef.shell.model import Shell
-from graspdef.solve.sparse import solve_kkt
-R, L = 300.0, 600.0
+sys.path.insert(0, sys.argv[3])
+from convergence import pinched_cylinder_problem
+from graspdef.solve.linear import solve_linear
 runs = []
 for rep in range(repeats + 1):          # the first run warms caches (numba, imports) and is dropped
     t0 = time.perf_counter()
-    m = cylinder(R, L, 2 * n_z, n_z)
-    sh = Shell(m.vertices, m.faces, LinearElastic(3e6, 0.3), 3.0)
-    ends = lambda p: (np.abs(p[:, 2]) < 1e-6) | (np.abs(p[:, 2] - L) < 1e-6)
-    sup = [EdgeSupport("diaphragm", ends, normal=(0, 0, 1))]
-    ev = Problem(sh, [], sup + [PointSupport(0, (1.0, 0.0, 0.0), ((0, 0, 1),))]).evaluator
-    A, _ = locate(sh, ev, [R, 0, L / 2], "A"); B, _ = locate(sh, ev, [-R, 0, L / 2], "B")
-    C, _ = locate(sh, ev, [0, R, L / 2], "C")
-    pr = Problem(sh, [PointLoad(A.face, A.bary, (-1.0, 0, 0)), PointLoad(B.face, B.bary, (1.0, 0, 0))],
-                 sup + [PointSupport(C.face, C.bary, ((0, 0, 1),))], {"A": A})
+    pr = pinched_cylinder_problem(n_z)
     t1 = time.perf_counter()
-    _, _, K = ShellEnergy(sh).hessian(sh.rest_positions)
-    Kb = pr.boundary_stiffness()
-    K = (K + Kb).tocsr() if Kb.nnz else K
-    f = pr.load_vector()
-    Cm, _ = pr.constraints()
-    t2 = time.perf_counter()
-    kkt = solve_kkt(K, Cm, f)
-    t3 = time.perf_counter()
-    st, w = pr.evaluator.values(A.face, np.asarray(A.bary))
-    uA = -(w @ kkt.u.reshape(-1, 3)[st])[0]
+    sol = solve_linear(pr)
+    t = sol.timings
     if rep:
-        runs.append({"setup": t1 - t0, "assembly": t2 - t1, "solve": t3 - t2, "factor": kkt.seconds_factor,
-                     "u_A": float(uA), "nnz": int(K.nnz), "n_dofs": int(K.shape[0]), "m": int(Cm.shape[0]),
-                     "n_control": int(m.n_vertices), "backend": kkt.backend})
+        runs.append({"setup": t1 - t0, "assembly": t["assembly"] + t["loads_constraints"],
+                     "solve": t["factor"] + t["solve"], "factor": t["factor"],
+                     "u_A": float(-sol.probe("A")[0]), "n_dofs": int(pr.shell.n_dofs),
+                     "m": int(len(sol.kkt.multipliers)), "n_control": int(pr.shell.mesh.n_real),
+                     "backend": sol.kkt.backend})
 peak = 0
 for line in open("/proc/self/status"):
     if line.startswith("VmHWM"):
@@ -74,13 +54,13 @@ print(json.dumps({"runs": runs, "peak_MB": peak}))
 
 def measure(n_z: int, repeats: int) -> dict:
     t0 = time.perf_counter()
-    out = subprocess.run([sys.executable, "-c", CHILD, str(n_z), str(repeats)], capture_output=True,
+    out = subprocess.run([sys.executable, "-c", CHILD, str(n_z), str(repeats), str(Path(__file__).parent)], capture_output=True,
                          text=True, check=True)
     data = json.loads(out.stdout.strip().splitlines()[-1])
     runs = data["runs"]
     med = {k: statistics.median(r[k] for r in runs) for k in ("setup", "assembly", "solve", "factor")}
     first = runs[0]
-    return {"n_z": n_z, "n_control": first["n_control"], "n_dofs": first["n_dofs"], "nnz": first["nnz"],
+    return {"n_z": n_z, "n_control": first["n_control"], "n_dofs": first["n_dofs"],
             "n_constraints": first["m"], "backend": first["backend"], "repeats": len(runs),
             "median": med, "assembly_plus_solve": med["assembly"] + med["solve"],
             "total": med["setup"] + med["assembly"] + med["solve"], "peak_MB": data["peak_MB"],
@@ -99,11 +79,11 @@ def main() -> None:
     for n_z, r in zip(a.sizes, reps):
         print(f"pinched cylinder n_z={n_z}: {r} timed runs ...", file=sys.stderr, flush=True)
         rows.append(measure(n_z, r))
-    print("| control vertices | dofs | K nnz | set-up [s] | assembly [s] | solve [s] (factor) | assembly + solve [s] | peak memory [MB] | u_A error |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| control vertices | dofs | set-up [s] | assembly [s] | solve [s] (factor) | assembly + solve [s] | peak memory [MB] | u_A error |")
+    print("|---|---|---|---|---|---|---|---|")
     for x in rows:
         m = x["median"]
-        print(f"| {x['n_control']} | {x['n_dofs']} | {x['nnz']} | {m['setup']:.2f} | {m['assembly']:.2f} | "
+        print(f"| {x['n_control']} | {x['n_dofs']} | {m['setup']:.2f} | {m['assembly']:.2f} | "
               f"{m['solve']:.2f} ({m['factor']:.2f}) | {x['assembly_plus_solve']:.2f} | {x['peak_MB']:.0f} | "
               f"{100 * x['rel_error']:+.3f} % |")
     print(f"medians of {', '.join(str(x['repeats']) for x in rows)} runs (after one warm-up run each), backend {rows[0]['backend']}")

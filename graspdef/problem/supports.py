@@ -132,7 +132,7 @@ _CORNERS = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
 def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: int = 2):
     """Assemble C (m, 3 n_control) and a per-row label list.
 
-    Returns (C csr, labels list[str], points (m_pts, 3) collocation points for reporting)."""
+    Returns (C csr, labels: one string per row naming the support and edge)."""
     x = shell.rest_positions
     xv = np.asarray(shell.vertices, dtype=float)          # the given geometry, for region predicates
     n = shell.n_control

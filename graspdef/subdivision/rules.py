@@ -125,17 +125,10 @@ def refine(faces: np.ndarray, n_vertices: int) -> tuple[sp.csr_matrix, np.ndarra
 
 def limit_positions(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """Limit-surface points of the interior control vertices (NaN at boundary vertices)."""
-    f = np.asarray(faces, dtype=np.int64)
-    nv = len(vertices)
-    edges, _ = mesh_edges(f)
-    inner = interior_mask(f, nv)
-    val = np.bincount(edges.ravel(), minlength=nv)
-    chi = limit_weight(np.maximum(val, 3))
-    nsum = np.zeros_like(np.asarray(vertices, dtype=float))
-    np.add.at(nsum, edges[:, 0], vertices[edges[:, 1]])
-    np.add.at(nsum, edges[:, 1], vertices[edges[:, 0]])
-    out = (1.0 - val * chi)[:, None] * vertices + chi[:, None] * nsum
-    out[~inner] = np.nan
+    x = np.asarray(vertices, dtype=float)
+    inner = np.flatnonzero(interior_mask(np.asarray(faces, dtype=np.int64), len(x)))
+    out = np.full_like(x, np.nan)
+    out[inner] = limit_matrix(faces, len(x), inner) @ x
     return out
 
 
