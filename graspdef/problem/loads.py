@@ -80,7 +80,45 @@ class BodyForce:
         return f
 
 
-Load = PointLoad | Pressure | BodyForce
+@dataclass(frozen=True)
+class EdgeLoad:
+    """Dead line load ``force`` [N/m] (per unit rest length) on the boundary edges whose two end
+    vertices satisfy ``where`` (callable (n, 3) -> (n,) bool on rest positions [m]); integrated
+    along the limit boundary curve with ``n_points`` Gauss points per edge."""
+
+    where: object
+    force: tuple[float, float, float]
+    name: str = "edge_load"
+    n_points: int = 3
+
+    def vector(self, shell: Shell, ev: SurfaceEvaluator) -> np.ndarray:
+        F = _finite_vector(f"edge load '{self.name}' force", self.force)
+        mesh = shell.mesh
+        ab = mesh.boundary_edges
+        if len(ab) == 0:
+            raise ProblemError(f"edge load '{self.name}': the surface has no boundary edges")
+        xv = np.asarray(shell.vertices, float)
+        mask = np.asarray(self.where(xv[ab[:, 0]]), bool) & np.asarray(self.where(xv[ab[:, 1]]), bool)
+        if not mask.any():
+            raise ProblemError(f"edge load '{self.name}': its region selects no boundary edge")
+        t_gl, w_gl = np.polynomial.legendre.leggauss(self.n_points)
+        taus, wts = 0.5 * (t_gl + 1.0), 0.5 * w_gl
+        corners = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+        X = shell.rest_positions
+        f = np.zeros((shell.n_control, 3))
+        for e in np.flatnonzero(mask):
+            face = int(mesh.boundary_faces[e])
+            i = int(np.flatnonzero(mesh.faces[face] == ab[e, 0])[0])
+            chart = corners[(i + 1) % 3] - corners[i]
+            pts = (1 - taus)[:, None] * corners[i] + taus[:, None] * corners[(i + 1) % 3]
+            st, N, dN, _ = ev.basis(face, pts)
+            for q in range(len(taus)):
+                ds = np.linalg.norm((dN[q] @ chart) @ X[st])
+                np.add.at(f, st, (wts[q] * ds * N[q])[:, None] * F[None, :])
+        return f
+
+
+Load = PointLoad | Pressure | BodyForce | EdgeLoad
 
 
 def load_vector(shell: Shell, loads: list, ev: SurfaceEvaluator) -> np.ndarray:

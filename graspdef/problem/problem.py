@@ -1,6 +1,7 @@
 """The Problem: a shell with loads, supports and named probe points; what every solver receives."""
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -10,6 +11,7 @@ from ..errors import ProblemError
 from ..shell.model import Shell
 from ..subdivision.evaluate import SurfaceEvaluator, project_point
 from .loads import PointLoad, load_vector
+from .potentials import EnclosedGas, is_potential
 from .supports import check_rigid_modes, constraint_rows, independent_rows, nitsche_matrix
 
 
@@ -85,18 +87,36 @@ class Problem:
         """Closest limit-surface point to ``point`` [m] (see :func:`locate`)."""
         return locate(self.shell, self.evaluator, point, name, tol)[0]
 
+    def dead_load_vector(self) -> np.ndarray:
+        """Sum of the dead (configuration-independent) loads, (3 n_control,) [N]."""
+        return load_vector(self.shell, [ld for ld in self.loads if not is_potential(ld)], self.evaluator)
+
+    def potentials(self) -> list:
+        """The configuration-dependent loads, bound to this shell with fresh state."""
+        return [copy.copy(ld).bind(self.shell, self.evaluator) for ld in self.loads if is_potential(ld)]
+
     def load_vector(self) -> np.ndarray:
-        """External force vector (3 n_control,) [N]."""
-        return load_vector(self.shell, self.loads, self.evaluator)
+        """External force vector of linear theory (3 n_control,) [N]: the dead loads plus the
+        configuration-dependent loads evaluated at rest.  An enclosed gas has no linear load."""
+        f = self.dead_load_vector()
+        x = self.shell.rest_positions
+        for pot in self.potentials():
+            if isinstance(pot, EnclosedGas):
+                raise ProblemError("an enclosed gas couples pressure and volume nonlinearly: use the nonlinear "
+                                   "solver (solver.type = \"nonlinear\")")
+            f = f + pot.load(x)
+        return f
 
     def boundary_stiffness(self):
         """Nitsche terms for rotation-fixed edges, (3 n_control, 3 n_control) sparse."""
         return nitsche_matrix(self.shell, self.supports, self.evaluator)
 
-    def constraints(self):
-        """C (m, 3 n_control) and row labels; raises SupportError if rigid modes stay free."""
-        C, labels = constraint_rows(self.shell, self.supports, self.evaluator, self.n_collocation)
+    def constraints(self, with_targets: bool = False):
+        """C (m, 3 n_control) and row labels (and, ``with_targets``, the prescribed values g (m,)
+        [m] of C u = g at load factor 1); raises SupportError if rigid modes stay free."""
+        C, labels, g = constraint_rows(self.shell, self.supports, self.evaluator, self.n_collocation,
+                                       with_targets=True)
         keep = independent_rows(C)
-        C, labels = C[keep], [labels[i] for i in keep]
-        check_rigid_modes(C, self.shell.rest_positions)
-        return C, labels
+        C, labels, g = C[keep], [labels[i] for i in keep], g[keep]
+        check_rigid_modes(C, self.shell.rest_positions, Kb=self.boundary_stiffness())
+        return (C, labels, g) if with_targets else (C, labels)

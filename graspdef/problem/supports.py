@@ -91,12 +91,23 @@ class EdgeSupport:
 
 @dataclass(frozen=True)
 class PointSupport:
-    """Displacement of one limit-surface point fixed along ``directions`` (k, 3)."""
+    """Displacement of one limit-surface point fixed along ``directions`` (k, 3).
+
+    ``displacement`` (k,) [m], optional: prescribed displacement along each direction at load
+    factor 1 (displacement control; scaled by the load factor in nonlinear solves).  Default 0."""
 
     face: int
     bary: tuple[float, float, float]
     directions: tuple[tuple[float, float, float], ...] = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
     name: str = "point"
+    displacement: tuple[float, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if self.displacement is not None:
+            d = np.asarray(self.displacement, dtype=float)
+            if d.shape != (len(self.directions),) or not np.all(np.isfinite(d)):
+                raise ProblemError(f"support '{self.name}': displacement needs one finite value per direction "
+                                   f"({len(self.directions)}), got {self.displacement!r}")
 
 
 @dataclass(frozen=True)
@@ -129,14 +140,17 @@ def _edge_points(n_col: int) -> np.ndarray:
 _CORNERS = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
 
 
-def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: int = 2):
+def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: int = 2,
+                    with_targets: bool = False):
     """Assemble C (m, 3 n_control) and a per-row label list.
 
-    Returns (C csr, labels: one string per row naming the support and edge)."""
+    Returns (C csr, labels: one string per row naming the support and edge) and, with
+    ``with_targets``, the prescribed values g (m,) [m] of C u = g at load factor 1."""
     x = shell.rest_positions
     xv = np.asarray(shell.vertices, dtype=float)          # the given geometry, for region predicates
     n = shell.n_control
     rows, cols, vals, labels = [], [], [], []
+    targets: dict[int, float] = {}
     m = 0
 
     def add(st, weights, direction, label):
@@ -186,8 +200,12 @@ def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: i
                         add(st, N[qq], d, f"{sup.name}: edge {ab[e, 0]}-{ab[e, 1]}")
         elif isinstance(sup, PointSupport):
             st, w = ev.values(sup.face, np.asarray(sup.bary, float))
-            for d in np.asarray(sup.directions, dtype=float):
-                add(st, w, _unit(f"support '{sup.name}' direction", d), f"{sup.name}: u.{d.tolist()}")
+            disp = np.zeros(len(sup.directions)) if sup.displacement is None else np.asarray(sup.displacement, float)
+            for d, val in zip(np.asarray(sup.directions, dtype=float), disp):
+                dn = _unit(f"support '{sup.name}' direction", d)
+                if val != 0.0:
+                    targets[m] = float(val)
+                add(st, w, dn, f"{sup.name}: u.{d.tolist()}")
         elif isinstance(sup, RigidModes):
             R = rigid_modes(x)
             names = ["translation x", "translation y", "translation z", "rotation x", "rotation y", "rotation z"]
@@ -200,29 +218,31 @@ def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: i
         else:
             raise ProblemError(f"unknown support object {sup!r}")
     del any_edge
+    g = np.zeros(m)
+    for i, val in targets.items():
+        g[i] = val
     if m == 0:
-        return sp.csr_matrix((0, 3 * n)), labels
-    C = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(m, 3 * n))
-    C.sum_duplicates()
-    C.eliminate_zeros()          # structural zeros would merge independent clusters
-    return C, labels
+        C = sp.csr_matrix((0, 3 * n))
+    else:
+        C = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(m, 3 * n))
+        C.sum_duplicates()
+        C.eliminate_zeros()          # structural zeros would merge independent clusters
+    return (C, labels, g) if with_targets else (C, labels)
 
 
-def check_rigid_modes(C: sp.csr_matrix, x: np.ndarray, rtol: float = 1e-8) -> None:
-    """Raise SupportError naming any rigid-body motion that the constraints leave free."""
+def check_rigid_modes(C: sp.csr_matrix, x: np.ndarray, rtol: float = 1e-8, Kb: sp.spmatrix | None = None) -> None:
+    """Raise SupportError naming any rigid-body motion that the constraints C (and the Nitsche
+    rotation terms Kb, if given) leave free."""
     R = rigid_modes(x)
     CR = C @ R if C.shape[0] else np.zeros((0, 6))
-    if CR.shape[0] < 6:
-        s = np.zeros(6)
-        vt = np.eye(6)
-        if CR.shape[0]:
-            _, s_, vt_ = np.linalg.svd(CR)
-            s[: len(s_)] = s_
-            vt = vt_ if vt_.shape[0] == 6 else vt
-    else:
-        _, s, vt = np.linalg.svd(CR, full_matrices=True)
-    scale = max(s.max(initial=0.0), 1e-300)
-    free = [vt[i] for i in range(6) if s[i] <= rtol * scale or s[i] == 0.0]
+    M = CR.T @ CR
+    M = M / max(np.linalg.eigvalsh(M).max(initial=0.0), 1e-300) if M.any() else M
+    if Kb is not None and Kb.nnz:
+        Mk = R.T @ (Kb @ R)
+        Mk = 0.5 * (Mk + Mk.T)
+        M = M + Mk / max(np.abs(np.linalg.eigvalsh(Mk)).max(), 1e-300)
+    w, V = np.linalg.eigh(M)
+    free = [V[:, i] for i in range(6) if w[i] <= rtol ** 2 * max(w.max(), 1e-300) or w[i] <= 0.0]
     if free:
         desc = []
         for v in free:

@@ -5,16 +5,15 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..problem.problem import Problem
 from ..shell.energy import ShellEnergy
-from ..subdivision.rules import limit_matrix
+from .result import DisplacementField
 from .sparse import KKTResult, solve_kkt
 
 
 @dataclass
-class LinearSolution:
+class LinearSolution(DisplacementField):
     """Control-point displacements of a linear solve and what is derived from them.
 
     Attributes
@@ -36,28 +35,6 @@ class LinearSolution:
         """(1/2) f.u [J] (equal to the elastic energy at equilibrium of a linear problem)."""
         return 0.5 * float(self.load @ self.u.ravel())
 
-    def probe(self, name: str) -> np.ndarray:
-        sp_ = self.problem.probes[name]
-        st, w = self.problem.evaluator.values(sp_.face, np.asarray(sp_.bary))
-        return w @ self.u[st]
-
-    def limit_map(self) -> sp.csr_matrix:
-        mesh = self.problem.shell.mesh
-        return limit_matrix(mesh.faces, mesh.n_control, np.arange(mesh.n_real))
-
-    def vertex_displacements(self) -> np.ndarray:
-        """Limit displacements at the real control vertices, (n_vertices, 3) [m]."""
-        return self.limit_map() @ self.u
-
-    def deformed_surface(self, scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-        """Limit points of the real vertices after deformation, and the real faces."""
-        mesh = self.problem.shell.mesh
-        L = self.limit_map()
-        return L @ (mesh.vertices + scale * self.u), mesh.faces[: mesh.n_real_faces]
-
-    def max_displacement(self) -> float:
-        return float(np.linalg.norm(self.vertex_displacements(), axis=1).max())
-
     def net_load(self) -> tuple[np.ndarray, np.ndarray]:
         """Net force [N] and moment about the origin [N m] of the applied loads."""
         f = self.load.reshape(-1, 3)
@@ -75,9 +52,9 @@ def solve_linear(problem: Problem, backend: str = "auto") -> LinearSolution:
         K = (K + Kb).tocsr()
     t1 = time.perf_counter()
     f = problem.load_vector()
-    C, _ = problem.constraints()
+    C, _, g = problem.constraints(with_targets=True)
     t2 = time.perf_counter()
-    kkt = solve_kkt(K, C, f, backend=backend)
+    kkt = solve_kkt(K, C, f, backend=backend, g=g)
     timings = {"assembly": t1 - t0, "loads_constraints": t2 - t1, "factor": kkt.seconds_factor,
                "solve": kkt.seconds_solve}
     return LinearSolution(problem, kkt.u.reshape(-1, 3), kkt, timings, f)

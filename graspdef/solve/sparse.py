@@ -96,84 +96,145 @@ def kkt_upper(K: sp.spmatrix, C: sp.spmatrix, scale: float) -> sp.csr_matrix:
     return sp.csr_matrix((data, indices, indptr), shape=(n + m, n + m))
 
 
-def _factor_pardiso(U: sp.csr_matrix):
-    import pypardiso
+class KKTSystem:
+    """Factorisations of KKT matrices [[K, s C^T], [s C, 0]] for one constraint matrix C.
 
-    solver = pypardiso.PyPardisoSolver(mtype=-2)
-    solver.set_iparm(1, 1)      # use the values below, not the defaults
-    solver.set_iparm(2, 3)      # parallel METIS nested-dissection ordering
-    solver.set_iparm(8, 2)      # up to two steps of iterative refinement
-    solver.set_iparm(10, 8)     # pivot perturbation 1e-8 (then refined; the true residual is checked)
-    solver.set_iparm(11, 1)     # symmetric scaling
-    solver.set_iparm(13, 2)     # weighted matching, improved variant (saddle-point systems)
-    solver.set_iparm(21, 1)     # Bunch-Kaufman pivoting
-    # call the phases directly: pypardiso's factorize()/solve() copy and compare the matrix
-    solver._check_A(U)
-    z = np.zeros((U.shape[0], 1))
-    solver.set_phase(11)                                    # analysis (matching, ordering)
-    solver._call_pardiso(U, z)
-    solver.set_phase(22)                                    # numerical factorisation
-    solver._call_pardiso(U, z)
-    perturbed = int(solver.get_iparm(14))
-    n_neg = int(solver.get_iparm(23))
-    return solver, U, perturbed, n_neg
+    Repeated factorisations (Newton iterations) reuse PARDISO's analysis (ordering, matching)
+    while K's sparsity pattern is unchanged; every solution is refined and its residual in the
+    unperturbed system checked.  ``n_negative`` is the number of negative pivots of the last
+    factorisation (PARDISO) -- the inertia that decides stability -- or None (SuperLU).
+    Use as a context manager or call :meth:`close` to free PARDISO's memory.
+    """
+
+    def __init__(self, C: sp.spmatrix, backend: str = "auto"):
+        if backend not in BACKENDS:
+            raise SolverError(f"unknown linear solver backend '{backend}' (valid: {', '.join(BACKENDS)})")
+        if backend == "auto":
+            backend = "pardiso" if pardiso_available() else "superlu"
+        self.backend = backend
+        self.C = C.tocsr()
+        self.m = self.C.shape[0]
+        self._solver = None
+        self._pattern = None
+        self._lu = None
+        self.n_negative: int | None = None
+        self.perturbed = 0
+        self.scale = 1.0
+        self.seconds_factor = 0.0
+        self.seconds_solve = 0.0
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def close(self) -> None:
+        if self._solver is not None:
+            self._solver.free_memory(everything=True)
+            self._solver = None
+            self._pattern = None
+
+    def factor(self, K: sp.spmatrix, analyse: bool = False) -> None:
+        """Factor the KKT matrix of ``K``; ``analyse`` forces a fresh ordering/matching."""
+        t0 = time.perf_counter()
+        self.K = K.tocsr()
+        self.n = self.K.shape[0]
+        self.scale = constraint_scale(self.K)
+        if self.backend == "pardiso":
+            import pypardiso
+
+            U = kkt_upper(self.K, self.C, self.scale)
+            pattern = (U.shape, U.nnz, hash(U.indices[:: max(1, U.nnz // 4096)].tobytes()))
+            if self._solver is None:
+                self._solver = pypardiso.PyPardisoSolver(mtype=-2)
+                for k, v in _PARDISO_IPARM.items():
+                    self._solver.set_iparm(k, v)
+            s = self._solver
+            s._check_A(U)
+            z = np.zeros((U.shape[0], 1))
+            if analyse or pattern != self._pattern:
+                s.set_phase(11)                             # analysis (matching, ordering)
+                s._call_pardiso(U, z)
+                self._pattern = pattern
+            s.set_phase(22)                                 # numerical factorisation
+            s._call_pardiso(U, z)
+            self._U = U
+            self.perturbed = int(s.get_iparm(14))
+            self.n_negative = int(s.get_iparm(23))
+        else:
+            A, _ = kkt_matrix(self.K, self.C)
+            try:
+                self._lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A")
+            except RuntimeError as exc:
+                raise SupportError(f"the constrained stiffness is singular ({exc}): a mechanism is free") from exc
+            self.n_negative = None
+        self.seconds_factor += time.perf_counter() - t0
+
+    def _back(self, b: np.ndarray) -> np.ndarray:
+        if self.backend == "pardiso":
+            self._solver.set_phase(33)
+            return self._solver._call_pardiso(self._U, np.asfortranarray(b)).reshape(b.shape)
+        return self._lu.solve(b)
+
+    def solve(self, f: np.ndarray, g: np.ndarray | None = None, rtol: float = 1e-8,
+              refinements: int = 3) -> tuple[np.ndarray, np.ndarray, float]:
+        """Solve K u + C^T l = f, C u = g for one (n,) or several (n, k) right-hand sides.
+
+        Returns (u, l, relative residual); raises SolverError above ``rtol``."""
+        t0 = time.perf_counter()
+        n, m = self.n, self.m
+        f = np.asarray(f, float)
+        g = np.zeros((m,) + f.shape[1:]) if g is None else np.asarray(g, float).reshape((m,) + f.shape[1:])
+        s = self.scale
+        rhs = np.concatenate([f, s * g])
+        K, C = self.K, self.C
+
+        def residual(x):
+            return np.concatenate([K @ x[:n] + s * (C.T @ x[n:]), s * (C @ x[:n])]) - rhs
+
+        bn = max(float(np.linalg.norm(rhs)), 1e-300)
+        sol = self._back(rhs)
+        res = residual(sol)
+        for _ in range(refinements):
+            if not np.all(np.isfinite(sol)) or np.linalg.norm(res) <= 0.01 * rtol * bn:
+                break
+            sol = sol - self._back(res)
+            res = residual(sol)
+        self.seconds_solve += time.perf_counter() - t0
+        if not np.all(np.isfinite(sol)):
+            raise SolverError("the linear solve produced non-finite values (singular system)")
+        rel = float(np.linalg.norm(res) / bn)
+        if rel > rtol:
+            raise SolverError(f"linear solve residual {rel:.2e} exceeds {rtol:.0e} (ill-conditioned or singular)")
+        return sol[:n], s * sol[n:], rel
+
+
+#: PARDISO settings (1-based iparm): see the README's solver section
+_PARDISO_IPARM = {
+    1: 1,       # use the values below, not the defaults
+    2: 3,       # parallel METIS nested-dissection ordering
+    8: 2,       # up to two steps of iterative refinement
+    10: 8,      # pivot perturbation 1e-8 (then refined; the true residual is checked)
+    11: 1,      # symmetric scaling
+    13: 2,      # weighted matching, improved variant (saddle-point systems)
+    21: 1,      # Bunch-Kaufman pivoting
+}
 
 
 def solve_kkt(K: sp.spmatrix, C: sp.spmatrix, f: np.ndarray, backend: str = "auto",
-              rtol: float = 1e-8, refinements: int = 3) -> KKTResult:
-    """Solve the KKT system; raise SupportError/SolverError on singular or unbalanced systems."""
-    if backend not in BACKENDS:
-        raise SolverError(f"unknown linear solver backend '{backend}' (valid: {', '.join(BACKENDS)})")
-    if backend == "auto":
-        backend = "pardiso" if pardiso_available() else "superlu"
-    n, m = K.shape[0], C.shape[0]
-    K = K.tocsr()
-    C = C.tocsr()
-    scale = constraint_scale(K)
-    rhs = np.concatenate([f, np.zeros(m)])
-    t0 = time.perf_counter()
-    n_neg = None
-    if backend == "pardiso":
-        solver, U, perturbed, n_neg = _factor_pardiso(kkt_upper(K, C, scale))
-        t1 = time.perf_counter()
-        if n_neg != m:
+              rtol: float = 1e-8, refinements: int = 3, g: np.ndarray | None = None) -> KKTResult:
+    """Solve K u + C^T l = f, C u = g (default g = 0); raise SupportError/SolverError on singular
+    or unbalanced systems."""
+    with KKTSystem(C, backend) as kkt:
+        kkt.factor(K)
+        m = kkt.m
+        if kkt.n_negative is not None and kkt.n_negative != m:
             raise SupportError(
-                f"the constrained stiffness is singular or indefinite: the KKT matrix has {n_neg} negative "
-                f"pivots for {m} constraints (expected {m}; {perturbed} pivots perturbed). A mechanism is "
-                "free (a part without supports, or redundant/conflicting supports).")
-        log.info("PARDISO: %d perturbed pivots (removed by iterative refinement; residual checked)", perturbed)
-        solver.set_phase(33)                                # solve with iterative refinement
-        back = lambda b: solver._call_pardiso(U, np.asfortranarray(b)).ravel()  # noqa: E731
-    else:
-        A, _ = kkt_matrix(K, C)
-        try:
-            lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A")
-        except RuntimeError as exc:
-            raise SupportError(f"the constrained stiffness is singular ({exc}): a mechanism is free") from exc
-        t1 = time.perf_counter()
-        back = lu.solve
-
-    def residual(x: np.ndarray) -> np.ndarray:
-        return np.concatenate([K @ x[:n] + scale * (C.T @ x[n:]), scale * (C @ x[:n])]) - rhs
-
-    fn = max(np.linalg.norm(f), 1e-300)
-    try:
-        sol = back(rhs)
-        res = residual(sol)
-        for _ in range(refinements):                        # a few more steps on ill-conditioned systems
-            if not np.all(np.isfinite(sol)) or np.linalg.norm(res) <= 0.01 * rtol * fn:
-                break
-            sol = sol - back(res)
-            res = residual(sol)
-    finally:
-        if backend == "pardiso":
-            solver.free_memory(everything=True)
-    t2 = time.perf_counter()
-    if not np.all(np.isfinite(sol)):
-        raise SolverError("the linear solve produced non-finite values (singular system)")
-    u, lam = sol[:n], sol[n:]
-    rel = float(np.linalg.norm(res) / fn)
-    if rel > rtol:
-        raise SolverError(f"linear solve residual {rel:.2e} exceeds {rtol:.0e} (ill-conditioned or singular)")
-    log.info("KKT %s: n=%d m=%d factor %.3fs solve %.3fs residual %.1e", backend, n, m, t1 - t0, t2 - t1, rel)
-    return KKTResult(u, scale * lam, backend, n_neg, t1 - t0, t2 - t1, rel)
+                f"the constrained stiffness is singular or indefinite: the KKT matrix has {kkt.n_negative} "
+                f"negative pivots for {m} constraints (expected {m}; {kkt.perturbed} pivots perturbed). A "
+                "mechanism is free (a part without supports, or redundant/conflicting supports).")
+        u, lam, rel = kkt.solve(f, g, rtol=rtol, refinements=refinements)
+    log.info("KKT %s: n=%d m=%d factor %.3fs solve %.3fs residual %.1e", kkt.backend, len(f), m,
+             kkt.seconds_factor, kkt.seconds_solve, rel)
+    return KKTResult(u, lam, kkt.backend, kkt.n_negative, kkt.seconds_factor, kkt.seconds_solve, rel)

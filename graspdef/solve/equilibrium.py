@@ -1,0 +1,142 @@
+"""The discrete equilibrium problem of the nonlinear solvers.
+
+Total potential energy of the control points x = X + u at load factor lam::
+
+    Pi(x, lam) = E(x) + 1/2 u.Kb.u - lam f.u + sum_i Pi_i(x, lam)
+
+with the shell's elastic energy E, the Nitsche rotation terms Kb of clamped/symmetry edges
+(constant: they act where rotations are held near zero), the dead loads f and the
+configuration-dependent loads Pi_i (``graspdef.problem.potentials``).  Supports are the linear
+constraints C u = lam g (g non-zero for prescribed displacements).  The load direction is
+q(x) = -d(grad Pi)/d lam = f + sum_i load_i(x).
+
+Each linearised step solves the KKT system of the Hessian H (+ rank-one parts, by the Woodbury
+identity) and reports its inertia: the equilibrium is stable when the KKT matrix has exactly
+m negative eigenvalues (m constraints), i.e. H is positive definite on the null space of C.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..errors import SolverError
+from ..problem.problem import Problem
+from ..shell.energy import ShellEnergy
+from .sparse import KKTSystem
+
+
+@dataclass
+class State:
+    """Energy, gradient, Hessian and load direction at (x, lam)."""
+
+    energy: float
+    gradient: np.ndarray
+    hessian: sp.csr_matrix | None
+    rank_one: list
+    load: np.ndarray
+
+
+class Equilibrium:
+    """Energy, residual and tangent solves of a :class:`Problem` (see the module docstring)."""
+
+    def __init__(self, problem: Problem, backend: str = "auto"):
+        self.problem = problem
+        shell = problem.shell
+        self.X = shell.rest_positions.copy()
+        self.n = shell.n_dofs
+        self.energy_fn = ShellEnergy(shell)
+        self.Kb = problem.boundary_stiffness().tocsr()
+        self.f = problem.dead_load_vector()
+        self.potentials = problem.potentials()
+        self.C, self.labels, self.g = problem.constraints(with_targets=True)
+        self.m = self.C.shape[0]
+        self.kkt = KKTSystem(self.C, backend)
+        self._CCt = spla.splu((self.C @ self.C.T).tocsc()) if self.m else None
+        self.n_factorisations = 0
+
+    def close(self) -> None:
+        self.kkt.close()
+
+    # ---- energy and derivatives -------------------------------------------------------------
+    def evaluate(self, u: np.ndarray, lam: float, order: int = 2) -> State:
+        """Pi, grad Pi, Hessian (order 2) and q at displacement u (3n,) and load factor lam."""
+        x = self.X + u.reshape(-1, 3)
+        if order == 0:
+            E = self.energy_fn.energy(x)
+            grad = None
+        elif order == 1:
+            E, grad = self.energy_fn.gradient(x)
+            H = None
+        else:
+            E, grad, H = self.energy_fn.hessian(x)
+        E += 0.5 * float(u @ (self.Kb @ u)) - lam * float(self.f @ u) if self.Kb.nnz else -lam * float(self.f @ u)
+        rank_one: list = []
+        q = self.f.copy()
+        if order >= 1:
+            grad = grad + (self.Kb @ u if self.Kb.nnz else 0.0) - lam * self.f
+            if order == 2 and self.Kb.nnz:
+                H = (H + self.Kb).tocsr()
+        for pot in self.potentials:
+            t = pot.evaluate(x, lam, order=max(order, 1))
+            E += t.value
+            if order >= 1:
+                grad = grad + t.gradient
+                q = q + pot.load(x)
+            if order == 2:
+                if t.hessian is not None:
+                    H = (H + t.hessian).tocsr()
+                rank_one += t.rank_one
+        return State(float(E), grad, H if order == 2 else None, rank_one, q)
+
+    def energy(self, u: np.ndarray, lam: float) -> float:
+        return self.evaluate(u, lam, order=0).energy
+
+    def commit(self, u: np.ndarray) -> None:
+        """Tell the state-tracking loads (edge rotations) that ``u`` is converged."""
+        x = self.X + u.reshape(-1, 3)
+        for pot in self.potentials:
+            pot.commit(x)
+
+    # ---- residuals ----------------------------------------------------------------------------
+    def projected_residual(self, grad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Residual grad + C^T mu with least-squares reactions mu (what equilibrium leaves)."""
+        if not self.m:
+            return grad, np.zeros(0)
+        mu = -self._CCt.solve(self.C @ grad)
+        return grad + self.C.T @ mu, mu
+
+    def constraint_residual(self, u: np.ndarray, lam: float) -> np.ndarray:
+        """lam g - C u: what the next step must add to satisfy the supports."""
+        return lam * self.g - self.C @ u if self.m else np.zeros(0)
+
+    # ---- tangent solves ------------------------------------------------------------------------
+    def factor(self, state: State) -> int | None:
+        """Factor the KKT matrix of the state's Hessian; returns the inertia excess (negative
+        eigenvalues of H on the constraint null space; 0 = stable) or None (no inertia)."""
+        self.kkt.factor(state.hessian)
+        self.n_factorisations += 1
+        self._lowrank = None
+        neg = self.kkt.n_negative
+        if state.rank_one:
+            V = np.stack([v for _, v in state.rank_one], axis=1)             # (n, k)
+            c = np.array([c for c, _ in state.rank_one])
+            W, _, _ = self.kkt.solve(V)                                       # A^-1 [V; 0]
+            S = np.diag(1.0 / c) + V.T @ W                                    # C^-1 + V^T A^-1 V
+            self._lowrank = (V, W, S)
+            if neg is not None:
+                neg = neg + int((np.linalg.eigvalsh(-S) < 0).sum()) - len(c)
+        return None if neg is None else neg - self.m
+
+    def solve(self, rhs: np.ndarray, g: np.ndarray | None = None) -> np.ndarray:
+        """Solve (H + sum c v v^T) du + C^T l = rhs, C du = g with the last factorisation;
+        ``rhs`` (n,) or (n, k)."""
+        du, _, _ = self.kkt.solve(rhs, g)
+        if self._lowrank is not None:
+            V, W, S = self._lowrank
+            du = du - W @ np.linalg.solve(S, V.T @ du)
+        if not np.all(np.isfinite(du)):
+            raise SolverError("the tangent solve produced non-finite values")
+        return du

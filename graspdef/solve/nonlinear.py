@@ -1,0 +1,465 @@
+"""Nonlinear equilibrium paths: Newton's method with load stepping, and arc-length continuation.
+
+* Load (or displacement) control: the load factor lam goes from 0 to ``max_load`` in adaptive
+  steps; Newton's method with an energy line search at each; a step that fails is halved, and
+  easy steps grow.  Requested ``targets`` are landed on exactly.
+* Arc-length (Crisfield's cylindrical constraint |du|^2 = dl^2, root closest to the previous
+  direction; predictor sign from the previous increment): passes limit points and snap-backs; the
+  arc length adapts to the number of Newton iterations.  Requested load levels crossed on the way
+  are solved exactly by a load-controlled Newton from the interpolated state.
+* Every converged point carries its stability (the inertia of the Hessian on the constraint null
+  space, from the factorisation's negative pivots); a change between points is reported as a
+  limit point (the load factor turns) or a bifurcation point (it does not).
+* Nothing unconverged is ever returned as a result: when the path cannot continue (the step is
+  cut below its minimum, the iteration limit on every retry) :class:`PathStopped` is raised with
+  the converged part of the path attached (or, with ``allow_partial``, the solution is returned
+  with ``completed = False`` and the reason).
+"""
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..errors import ProblemError, SolverError
+from ..problem.potentials import EnclosedGas
+from ..problem.problem import Problem
+from .equilibrium import Equilibrium
+from .result import DisplacementField
+
+log = logging.getLogger(__name__)
+
+METHODS = ("load", "arc_length")
+
+
+class PathStopped(SolverError):
+    """The load path could not continue; ``.solution`` holds the converged part."""
+
+    def __init__(self, message: str, solution: "NonlinearSolution"):
+        super().__init__(message)
+        self.solution = solution
+
+
+@dataclass(frozen=True)
+class PathOptions:
+    """Settings of a nonlinear solve.
+
+    method : "load" (load or displacement control) or "arc_length"
+    max_load : final load factor (loads and prescribed displacements are multiplied by it)
+    steps : initial number of steps to ``max_load`` (the step then adapts)
+    targets : load factors to land on exactly (e.g. tabulated loads)
+    max_steps : cap on accepted steps;  max_iterations : Newton iterations per attempt
+    tol : relative residual (|grad Pi + C^T mu| / force scale) for convergence
+    min_step : smallest load (or arc-length) fraction before the path stops
+    desired_iterations : the step adapts towards this many Newton iterations
+    max_growth : largest factor by which a step grows
+    line_search : energy back-tracking in load control
+    """
+
+    method: str = "load"
+    max_load: float = 1.0
+    steps: int = 10
+    targets: tuple[float, ...] = ()
+    max_steps: int = 400
+    max_iterations: int = 25
+    tol: float = 1e-8
+    min_step: float = 1e-6
+    desired_iterations: int = 5
+    max_growth: float = 2.0
+    line_search: bool = True
+
+    def __post_init__(self) -> None:
+        if self.method not in METHODS:
+            raise ProblemError(f"unknown path method '{self.method}' (valid: {', '.join(METHODS)})")
+        if not np.isfinite(self.max_load) or self.max_load == 0:
+            raise ProblemError(f"max_load must be a non-zero number, got {self.max_load!r}")
+        for name in ("steps", "max_steps", "max_iterations", "desired_iterations"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, np.integer)) or v < 1:
+                raise ProblemError(f"{name} must be a positive integer, got {v!r}")
+        if not (0 < self.tol < 1e-2):
+            raise ProblemError(f"tol must lie in (0, 1e-2), got {self.tol!r}")
+        if not (0 < self.min_step < 1):
+            raise ProblemError(f"min_step must lie in (0, 1), got {self.min_step!r}")
+        if not self.max_growth > 1:
+            raise ProblemError(f"max_growth must exceed 1, got {self.max_growth!r}")
+        t = np.asarray(self.targets, float)
+        if t.size and (not np.all(np.isfinite(t)) or np.any(t * np.sign(self.max_load) <= 0)
+                       or np.any(np.abs(t) > abs(self.max_load) * (1 + 1e-12))):
+            raise ProblemError(f"targets must lie between 0 and max_load={self.max_load}, got {self.targets!r}")
+
+
+@dataclass
+class PathPoint:
+    """One converged equilibrium of the path."""
+
+    load_factor: float
+    u: np.ndarray                    # (n_control, 3) [m]
+    energy: float                    # total potential energy Pi [J]
+    iterations: int                  # Newton iterations of the step that produced it
+    instability: int | None          # negative eigenvalues on the constraint null space (0: stable)
+    kind: str = "step"               # "step" or "target" (landed exactly on a requested load)
+    probes: dict = field(default_factory=dict)
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def stable(self) -> bool | None:
+        return None if self.instability is None else self.instability == 0
+
+
+@dataclass
+class NonlinearSolution(DisplacementField):
+    """The converged path of a nonlinear solve; ``u`` is its last point.
+
+    Attributes
+    ----------
+    path : list of PathPoint (start state first)
+    completed : whether ``max_load`` was reached;  stop_reason : why not
+    critical_points : detected limit and bifurcation points (dicts)
+    timings : seconds;  n_factorisations : tangent factorisations
+    """
+
+    problem: Problem
+    options: PathOptions
+    path: list = field(default_factory=list)
+    completed: bool = False
+    stop_reason: str | None = None
+    critical_points: list = field(default_factory=list)
+    timings: dict = field(default_factory=dict)
+    n_factorisations: int = 0
+
+    @property
+    def u(self) -> np.ndarray:
+        return self.path[-1].u
+
+    @property
+    def load_factor(self) -> float:
+        return self.path[-1].load_factor
+
+    def load_factors(self) -> np.ndarray:
+        return np.array([p.load_factor for p in self.path])
+
+    def probe_path(self, name: str) -> np.ndarray:
+        """Displacement (k, 3) [m] of a probe at every path point."""
+        return np.array([p.probes[name] for p in self.path])
+
+    def at(self, load_factor: float, rtol: float = 1e-9) -> PathPoint:
+        """The path point converged exactly at ``load_factor`` (a target or a step end)."""
+        for p in self.path:
+            if abs(p.load_factor - load_factor) <= rtol * max(1.0, abs(load_factor)):
+                return p
+        raise KeyError(f"no converged point at load factor {load_factor} (add it to the targets)")
+
+    def iterations(self) -> list[int]:
+        return [p.iterations for p in self.path[1:]]
+
+
+class _Failed(Exception):
+    pass
+
+
+class PathSolver:
+    """Runs one path (see the module docstring); use :func:`solve_nonlinear`."""
+
+    def __init__(self, problem: Problem, options: PathOptions, backend: str = "auto",
+                 progress: Callable[[dict], None] | None = None):
+        self.problem = problem
+        self.opt = options
+        self.progress = progress
+        self.eq = Equilibrium(problem, backend)
+        self.gas = [p for p in self.eq.potentials if isinstance(p, EnclosedGas)]
+        self.q_norm = 0.0
+
+    # ---------------------------------------------------------------------------------------
+    def _record(self, u, lam, energy, its, inst, kind="step") -> PathPoint:
+        x_u = u.reshape(-1, 3)
+        pt = PathPoint(float(lam), x_u.copy(), float(energy), int(its), inst, kind)
+        ev = self.problem.evaluator
+        for name, sp_ in self.problem.probes.items():
+            st, w = ev.values(sp_.face, np.asarray(sp_.bary))
+            pt.probes[name] = w @ x_u[st]
+        for i, gas in enumerate(self.gas):
+            V = gas._vol.value(self.eq.X + x_u)
+            pt.extra[f"gas{i}_volume_m3"] = V
+            pt.extra[f"gas{i}_gauge_pressure_Pa"] = gas.gauge_pressure(V)
+        return pt
+
+    def _converged(self, state, u, lam) -> tuple[bool, float]:
+        r, mu = self.eq.projected_residual(state.gradient)
+        internal = state.gradient + lam * state.load
+        scale = max(abs(lam) * float(np.linalg.norm(state.load)), float(np.linalg.norm(internal)),
+                    float(np.linalg.norm(self.eq.C.T @ mu)) if self.eq.m else 0.0, 1e-300)
+        rn = float(np.linalg.norm(r))
+        cres = self.eq.constraint_residual(u, lam)
+        cscale = max(float(np.linalg.norm(lam * self.eq.g)), float(np.linalg.norm(u)), 1e-300)
+        ok = (rn <= self.opt.tol * scale or rn <= 1e-13 * max(self.q_norm, 1e-300)) and \
+            float(np.linalg.norm(cres)) <= 1e-9 * cscale
+        return ok, rn / scale
+
+    def newton(self, u0: np.ndarray, lam: float):
+        """Equilibrium at fixed load factor from u0; returns (u, state, iterations, instability)."""
+        eq, opt = self.eq, self.opt
+        u = u0.copy()
+        inst = None
+        first = None
+        for it in range(opt.max_iterations + 1):
+            st = eq.evaluate(u, lam, 2)
+            ok, rel = self._converged(st, u, lam)
+            if not np.isfinite(st.energy) or not np.all(np.isfinite(st.gradient)):
+                raise _Failed(f"non-finite energy or forces at load factor {lam:.6g}")
+            if ok:
+                if inst is None and it == 0:
+                    inst = eq.factor(st)
+                return u, st, it, inst
+            if it == opt.max_iterations:
+                break
+            first = rel if first is None else first
+            if it >= 8 and rel > 10 * first:
+                raise _Failed(f"Newton diverges at load factor {lam:.6g} (residual {rel:.2e})")
+            inst = eq.factor(st)
+            cres = eq.constraint_residual(u, lam)
+            du = eq.solve(-st.gradient, cres)
+            alpha = 1.0
+            if opt.line_search and float(np.linalg.norm(cres)) <= 1e-12 * max(float(np.linalg.norm(u)), 1e-300):
+                slope = float(st.gradient @ du)
+                if slope < 0:
+                    for _ in range(8):
+                        e_new = eq.energy(u + alpha * du, lam)
+                        if np.isfinite(e_new) and e_new <= st.energy + 1e-4 * alpha * slope:
+                            break
+                        alpha *= 0.5
+                    else:
+                        alpha = 1.0                      # no decrease found: plain Newton step
+            u = u + alpha * du
+            log.debug("  newton it %d lam %.6g rel %.2e alpha %.3g |du| %.3e E %.12e", it, lam, rel, alpha, float(np.linalg.norm(du)), st.energy)
+        raise _Failed(f"Newton did not converge in {opt.max_iterations} iterations at load factor "
+                      f"{lam:.6g} (relative residual {rel:.2e})")
+
+    def _tangent(self, u, lam):
+        st = self.eq.evaluate(u, lam, 2)
+        self.eq.factor(st)
+        return self.eq.solve(st.load, self.eq.g)
+
+    def _emit(self, sol, pt, dl=None):
+        if self.progress is not None:
+            info = {"step": len(sol.path) - 1, "load_factor": pt.load_factor, "iterations": pt.iterations,
+                    "stable": pt.stable, "kind": pt.kind, "seconds": time.perf_counter() - self._t0}
+            if dl is not None:
+                info["arc_length"] = dl
+            self.progress(info)
+
+    def _detect(self, sol):
+        """Compare the last two points' stability (and the turn of lam) for critical points."""
+        if len(sol.path) < 2:
+            return
+        a, b = sol.path[-2], sol.path[-1]
+        if a.instability is None or b.instability is None or a.instability == b.instability:
+            return
+        steps = [p for p in sol.path if p.kind == "step"]
+        turned = False
+        if len(steps) >= 3:
+            d1 = steps[-2].load_factor - steps[-3].load_factor
+            d2 = steps[-1].load_factor - steps[-2].load_factor
+            turned = d1 * d2 < 0
+        kind = "limit point" if turned else "bifurcation point"
+        info = {"kind": kind, "between_load_factors": [a.load_factor, b.load_factor],
+                "instability_before": a.instability, "instability_after": b.instability,
+                "step": len(sol.path) - 1}
+        sol.critical_points.append(info)
+        log.info("%s between load factors %.6g and %.6g (negative eigenvalues %d -> %d)", kind,
+                 a.load_factor, b.load_factor, a.instability, b.instability)
+
+    # ---------------------------------------------------------------------------------------
+    def run(self) -> NonlinearSolution:
+        opt = self.opt
+        self._t0 = time.perf_counter()
+        sol = NonlinearSolution(self.problem, opt)
+        n = self.eq.n
+        u = np.zeros(n)
+        st0 = self.eq.evaluate(u, 0.0, 2)
+        self.q_norm = float(np.linalg.norm(st0.load))
+        if self.q_norm == 0 and not np.any(self.eq.g) and not self.gas:
+            raise ProblemError("the problem has no load: add loads, a prescribed displacement or an enclosed gas")
+        try:
+            if self.gas:                          # gas pre-load: equilibrium at lam = 0 first
+                u, st, its, inst = self.newton(u, 0.0)
+                energy = st.energy
+            else:
+                inst = self.eq.factor(st0)
+                energy, its = st0.energy, 0
+        except (_Failed, SolverError) as exc:
+            raise PathStopped(f"no equilibrium at zero load: {exc}", sol) from None
+        sol.path.append(self._record(u, 0.0, energy, its, inst, "start"))
+        self.eq.commit(u)
+        try:
+            if opt.method == "load":
+                self._load_control(sol, u)
+            else:
+                self._arc_length(sol, u)
+        except _Failed as exc:
+            sol.stop_reason = str(exc)
+        finally:
+            self.eq.close()
+        sol.timings["total"] = time.perf_counter() - self._t0
+        sol.timings["factor"] = self.eq.kkt.seconds_factor
+        sol.timings["solve"] = self.eq.kkt.seconds_solve
+        sol.n_factorisations = self.eq.n_factorisations
+        sol.completed = sol.stop_reason is None
+        return sol
+
+    def _stop_points(self):
+        sgn = np.sign(self.opt.max_load)
+        pts = sorted(set([float(t) for t in self.opt.targets] + [float(self.opt.max_load)]), key=lambda v: sgn * v)
+        return pts
+
+    def _load_control(self, sol, u):
+        opt = self.opt
+        lam_end = opt.max_load
+        dlam = lam_end / opt.steps
+        dmin = abs(lam_end) * opt.min_step
+        stops = self._stop_points()
+        lam = 0.0
+        u_prev, lam_prev = None, None
+        while len(sol.path) <= opt.max_steps:
+            nxt = next(s for s in stops if (s - lam) * np.sign(lam_end) > 1e-12 * abs(lam_end))
+            step = dlam if abs(dlam) < abs(nxt - lam) * (1 + 1e-9) else nxt - lam
+            if abs(nxt - lam - step) < 1e-9 * abs(lam_end):
+                step = nxt - lam
+            lam_new = lam + step
+            if u_prev is not None:                            # secant predictor
+                u0 = u + (u - u_prev) * (step / (lam - lam_prev))
+            else:                                             # tangent predictor from the rest state
+                try:
+                    u0 = u + step * self._tangent(u, lam)
+                except SolverError:
+                    u0 = u.copy()
+            try:
+                u_new, st, its, inst = self.newton(u0, lam_new)
+            except (_Failed, SolverError) as exc:
+                if abs(step) / 2 < dmin:
+                    raise _Failed(f"load step cut below {dmin:.3g} at load factor {lam:.6g}: {exc}") from None
+                log.info("step to %.6g failed (%s); halving", lam_new, exc)
+                dlam = step / 2
+                continue
+            is_target = abs(lam_new - nxt) <= 1e-12 * abs(lam_end)
+            pt = self._record(u_new, lam_new, st.energy, its, inst, "target" if is_target and nxt != lam_end else "step")
+            sol.path.append(pt)
+            self.eq.commit(u_new)
+            self._detect(sol)
+            self._emit(sol, pt)
+            u_prev, lam_prev, u, lam = u, lam, u_new, lam_new
+            if abs(lam - lam_end) <= 1e-12 * abs(lam_end):
+                return
+            growth = np.clip(np.sqrt(opt.desired_iterations / max(its, 1)), 0.5, opt.max_growth)
+            dlam = step * growth if abs(step) >= abs(dlam) * 0.999 else dlam
+        raise _Failed(f"the path needed more than max_steps={opt.max_steps} steps (reached load factor {lam:.6g})")
+
+    def _arc_length(self, sol, u):
+        opt = self.opt
+        eq = self.eq
+        lam_end = opt.max_load
+        sgn_end = np.sign(lam_end)
+        lam = 0.0
+        t = self._tangent(u, lam)                      # du/dlam at rest
+        dl0 = abs(lam_end / opt.steps) * float(np.linalg.norm(t))
+        if dl0 == 0:
+            raise _Failed("zero tangent at the start: the loads do not deform the shell")
+        dl = dl0
+        dl_min = dl0 * opt.min_step
+        dl_max = dl0 * 8
+        du_prev = t * np.sign(lam_end)
+        dlam_prev = float(sgn_end)
+        targets = [s for s in self._stop_points()]
+        while len(sol.path) <= opt.max_steps:
+            try:
+                u_new, lam_new, its, st, inst = self._arc_step(u, lam, dl, du_prev, dlam_prev)
+            except (_Failed, SolverError) as exc:
+                if dl / 2 < dl_min:
+                    raise _Failed(f"arc length cut below {dl_min:.3g} at load factor {lam:.6g}: {exc}") from None
+                log.info("arc step %.3g from lam %.6g failed (%s); halving", dl, lam, exc)
+                dl /= 2
+                continue
+            # requested load levels crossed by this step: land on them exactly
+            crossed = [s for s in targets if (s - lam) * (s - lam_new) <= 0 and s != lam]
+            for s in sorted(crossed, key=lambda v: abs(v - lam)):
+                w = (s - lam) / (lam_new - lam)
+                try:
+                    u_t, st_t, its_t, inst_t = self.newton(u + w * (u_new - u), s)
+                except (_Failed, SolverError) as exc:
+                    log.info("could not land on load factor %.6g (%s)", s, exc)
+                    continue
+                pt = self._record(u_t, s, st_t.energy, its_t, inst_t, "target")
+                sol.path.append(pt)
+                self._emit(sol, pt, dl)
+                if abs(s - lam_end) <= 1e-12 * abs(lam_end):
+                    pt.kind = "step"
+                    self.eq.commit(u_t)
+                    self._detect(sol)
+                    return
+            pt = self._record(u_new, lam_new, st.energy, its, inst, "step")
+            sol.path.append(pt)
+            eq.commit(u_new)
+            self._detect(sol)
+            self._emit(sol, pt, dl)
+            du_prev, dlam_prev = u_new - u, lam_new - lam
+            u, lam = u_new, lam_new
+            if (lam - lam_end) * sgn_end > 0:            # beyond the end without a landing
+                return
+            dl = float(np.clip(dl * np.sqrt(opt.desired_iterations / max(its, 1)), dl / 2,
+                               min(dl * opt.max_growth, dl_max)))
+        raise _Failed(f"the path needed more than max_steps={opt.max_steps} steps (reached load factor {lam:.6g})")
+
+    def _arc_step(self, u, lam, dl, du_prev, dlam_prev):
+        """One Crisfield step of arc length dl; returns (u, lam, iterations, state, instability)."""
+        eq, opt = self.eq, self.opt
+        st = eq.evaluate(u, lam, 2)
+        eq.factor(st)
+        t = eq.solve(st.load, eq.g)
+        tn = float(np.linalg.norm(t))
+        if tn == 0:
+            raise _Failed("zero tangent")
+        sgn = 1.0 if float(t @ du_prev) >= 0 else -1.0
+        dlam = sgn * dl / tn
+        Du = dlam * t
+        Dlam = dlam
+        for it in range(1, opt.max_iterations + 1):
+            un, ln = u + Du, lam + Dlam
+            st = eq.evaluate(un, ln, 2)
+            if not np.isfinite(st.energy) or not np.all(np.isfinite(st.gradient)):
+                raise _Failed(f"non-finite state near load factor {ln:.6g}")
+            ok, rel = self._converged(st, un, ln)
+            if ok and it > 1:
+                return un, ln, it - 1, st, inst
+            inst = eq.factor(st)
+            cres = eq.constraint_residual(un, ln)
+            sols = eq.solve(np.stack([-st.gradient, st.load], 1), np.stack([cres, eq.g], 1))
+            dR, dF = sols[:, 0], sols[:, 1]
+            a = float(dF @ dF)
+            b = 2.0 * float(dF @ (Du + dR))
+            c = float((Du + dR) @ (Du + dR)) - dl * dl
+            disc = b * b - 4 * a * c
+            if disc < 0:
+                raise _Failed(f"no real root of the arc-length constraint near load factor {ln:.6g}")
+            roots = [(-b + s * np.sqrt(disc)) / (2 * a) for s in (1.0, -1.0)]
+            best = max(roots, key=lambda r: float((Du + dR + r * dF) @ Du))
+            Du = Du + dR + best * dF
+            Dlam = Dlam + best
+        raise _Failed(f"arc-length corrector did not converge in {opt.max_iterations} iterations near load "
+                      f"factor {lam + Dlam:.6g} (relative residual {rel:.2e})")
+
+
+def solve_nonlinear(problem: Problem, options: PathOptions | None = None, backend: str = "auto",
+                    progress: Callable[[dict], None] | None = None, allow_partial: bool = False) -> NonlinearSolution:
+    """Follow the equilibrium path of ``problem`` (see the module docstring).
+
+    Raises PathStopped (with ``.solution``, the converged part) when the path cannot reach
+    ``options.max_load``, unless ``allow_partial``."""
+    opt = options or PathOptions()
+    sol = PathSolver(problem, opt, backend, progress).run()
+    if not sol.completed and not allow_partial:
+        raise PathStopped(f"the load path stopped at load factor {sol.load_factor:.6g} after "
+                          f"{len(sol.path) - 1} steps: {sol.stop_reason}", sol)
+    return sol
