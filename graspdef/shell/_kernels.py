@@ -7,12 +7,14 @@ import numpy as np
 
 
 @nb.njit(cache=True, parallel=True, fastmath=False)
-def material_hessian_blocks(D, J, C, dstride):
+def material_hessian_blocks(D, J, C, dstride, Hg=None):
     """sum_q G_q^T C_q G_q per face with G = ds/dx, G[i, s, a] = sum_K D[s, K] J[i, K, a].
 
     D : (nf|1, nq, S, 5) basis derivatives; J : (nf, nq, 6, 5, 3) ds/dy; C : (nf, nq, 6, 6)
     weighted material tangent, which must be symmetric (a Hessian of the energy density; only
     the upper triangle of each 36x36 block is computed and mirrored); ``dstride`` = 0 when D has a leading axis of 1 (shared), else 1.
+    ``Hg`` (nf, nq, 5, 3, 5, 3), optional: the stress (geometric) part sum_i sig_i d2 s_i/dy2 at
+    each point, added as sum_KL D[s, K] Hg[K, a, L, b] D[t, L].
     Returns (nf, S, S, 3, 3) blocks [s, t, a, b]."""
     nf, nq = J.shape[0], J.shape[1]
     S = D.shape[2]
@@ -21,6 +23,7 @@ def material_hessian_blocks(D, J, C, dstride):
         df = f * dstride
         G = np.empty((6, S, 3))
         CG = np.empty((6, S, 3))
+        T = np.empty((S, 3, 5, 3))
         for q in range(nq):
             for i in range(6):
                 for s in range(S):
@@ -44,6 +47,23 @@ def material_hessian_blocks(D, J, C, dstride):
                             for i in range(6):
                                 acc += G[i, s, a] * CG[i, t, b]
                             out[f, s, t, a, b] += acc
+            if Hg is not None:
+                for s in range(S):
+                    for a in range(3):
+                        for L in range(5):
+                            for b in range(3):
+                                acc = 0.0
+                                for K in range(5):
+                                    acc += D[df, q, s, K] * Hg[f, q, K, a, L, b]
+                                T[s, a, L, b] = acc
+                for s in range(S):
+                    for t in range(s, S):
+                        for a in range(3):
+                            for b in range(3):
+                                acc = 0.0
+                                for L in range(5):
+                                    acc += T[s, a, L, b] * D[df, q, t, L]
+                                out[f, s, t, a, b] += acc
         for s in range(S):
             for t in range(s + 1, S):
                 for a in range(3):

@@ -17,15 +17,6 @@ from .model import Shell, surface_derivatives
 _CHUNK = 8192
 
 
-def _dof_map(D: np.ndarray) -> np.ndarray:
-    """dy/dx for y = (a1, a2, a11, a22, a12): (f, q, 15, 3S) from basis derivatives D (f, q, S, 5)."""
-    nf, nq, S, _ = D.shape
-    B = np.zeros((nf, nq, 5, 3, S, 3))
-    for a in range(3):
-        B[:, :, :, a, :, a] = np.swapaxes(D, -1, -2)
-    return B.reshape(nf, nq, 15, 3 * S)
-
-
 class BlockPattern:
     """Sparsity pattern of the control-point coupling (vertex pairs sharing a stencil)."""
 
@@ -114,12 +105,12 @@ class ShellEnergy:
             ge = np.zeros((nf, S, 3))
         if order == 1:
             return (w * W).sum(), ge
-        He = material_hessian_blocks(np.ascontiguousarray(Dc), J, ddW * w[..., None, None], dstride)   # [f, s, t, a, b]
         if np.any(dW):                                                    # geometric (stress) part
-            B = _dof_map(D)
-            Hg = strain_hessian_contract(y, dW * w[..., None]).reshape(nf, nq, 15, 15)
-            Hgeo = (np.swapaxes(B, -1, -2) @ (Hg @ B)).sum(axis=1).reshape(nf, S, 3, S, 3)
-            He += Hgeo.transpose(0, 1, 3, 2, 4)
+            Hg = strain_hessian_contract(y, dW * w[..., None])            # (f, q, 5, 3, 5, 3)
+            He = material_hessian_blocks(np.ascontiguousarray(Dc), J, ddW * w[..., None, None], dstride,
+                                         np.ascontiguousarray(Hg))
+        else:
+            He = material_hessian_blocks(np.ascontiguousarray(Dc), J, ddW * w[..., None, None], dstride)
         return (w * W).sum(), ge, He
 
     def energy(self, x: np.ndarray) -> float:

@@ -57,6 +57,10 @@ class PathOptions:
     desired_iterations : the step adapts towards this many Newton iterations
     max_growth : largest factor by which a step grows
     line_search : energy back-tracking in load control
+    max_probe_displacement : [m] the path also ends (completed) once a probe has moved this far
+        (for paths whose load never reaches ``max_load``, e.g. past a pressure maximum)
+    refine_critical : arc-length bisections that narrow a change of stability down (each halves
+        the bracket; the load factor at a limit point is then accurate to O(bracket^2))
     """
 
     method: str = "load"
@@ -70,6 +74,8 @@ class PathOptions:
     desired_iterations: int = 5
     max_growth: float = 2.0
     line_search: bool = True
+    max_probe_displacement: float | None = None
+    refine_critical: int = 12
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -86,6 +92,8 @@ class PathOptions:
             raise ProblemError(f"min_step must lie in (0, 1), got {self.min_step!r}")
         if not self.max_growth > 1:
             raise ProblemError(f"max_growth must exceed 1, got {self.max_growth!r}")
+        if self.max_probe_displacement is not None and not self.max_probe_displacement > 0:
+            raise ProblemError(f"max_probe_displacement must be positive [m], got {self.max_probe_displacement!r}")
         t = np.asarray(self.targets, float)
         if t.size and (not np.all(np.isfinite(t)) or np.any(t * np.sign(self.max_load) <= 0)
                        or np.any(np.abs(t) > abs(self.max_load) * (1 + 1e-12))):
@@ -238,6 +246,10 @@ class PathSolver:
         raise _Failed(f"Newton did not converge in {opt.max_iterations} iterations at load factor "
                       f"{lam:.6g} (relative residual {rel:.2e})")
 
+    def _far(self, pt) -> bool:
+        lim = self.opt.max_probe_displacement
+        return lim is not None and any(float(np.linalg.norm(v)) >= lim for v in pt.probes.values())
+
     def _tangent(self, u, lam):
         st = self.eq.evaluate(u, lam, 2)
         self.eq.factor(st)
@@ -251,26 +263,33 @@ class PathSolver:
                 info["arc_length"] = dl
             self.progress(info)
 
-    def _detect(self, sol):
-        """Compare the last two points' stability (and the turn of lam) for critical points."""
-        if len(sol.path) < 2:
-            return
-        a, b = sol.path[-2], sol.path[-1]
-        if a.instability is None or b.instability is None or a.instability == b.instability:
-            return
-        steps = [p for p in sol.path if p.kind == "step"]
-        turned = False
-        if len(steps) >= 3:
-            d1 = steps[-2].load_factor - steps[-3].load_factor
-            d2 = steps[-1].load_factor - steps[-2].load_factor
-            turned = d1 * d2 < 0
-        kind = "limit point" if turned else "bifurcation point"
-        info = {"kind": kind, "between_load_factors": [a.load_factor, b.load_factor],
-                "instability_before": a.instability, "instability_after": b.instability,
-                "step": len(sol.path) - 1}
-        sol.critical_points.append(info)
-        log.info("%s between load factors %.6g and %.6g (negative eigenvalues %d -> %d)", kind,
-                 a.load_factor, b.load_factor, a.instability, b.instability)
+    @staticmethod
+    def _detect(sol):
+        """Every change of stability between consecutive path points."""
+        for i in range(1, len(sol.path)):
+            a, b = sol.path[i - 1].instability, sol.path[i].instability
+            if a is not None and b is not None and a != b:
+                sol.critical_points.append({"index": i, "instability_before": a, "instability_after": b})
+
+    @staticmethod
+    def _classify(sol):
+        """Limit point if the load factor has an extremum at the change, else bifurcation."""
+        lam = sol.load_factors()
+        for cp in sol.critical_points:
+            i = cp.pop("index")
+            turned = False
+            if i >= 2 and i + 1 < len(lam):
+                up = lam[i - 1] - lam[i - 2]
+                turned = up * (lam[i + 1] - lam[i]) < 0
+            if turned:
+                k = (i - 1) if (lam[i - 1] >= lam[i]) == (up > 0) else i
+            cp["kind"] = "limit point" if turned else "bifurcation point"
+            cp["load_factor"] = float(lam[k]) if turned else float(0.5 * (lam[i - 1] + lam[i]))
+            cp["bracket"] = [float(lam[i - 1]), float(lam[i])]
+            p = sol.path[k] if turned else sol.path[i]
+            cp["probes"] = {name: np.asarray(v).tolist() for name, v in p.probes.items()}
+            log.info("%s at load factor %.6g (negative eigenvalues %d -> %d)", cp["kind"], cp["load_factor"],
+                     cp["instability_before"], cp["instability_after"])
 
     # ---------------------------------------------------------------------------------------
     def run(self) -> NonlinearSolution:
@@ -308,6 +327,8 @@ class PathSolver:
         sol.timings["solve"] = self.eq.kkt.seconds_solve
         sol.n_factorisations = self.eq.n_factorisations
         sol.completed = sol.stop_reason is None
+        self._detect(sol)
+        self._classify(sol)
         return sol
 
     def _stop_points(self):
@@ -348,10 +369,9 @@ class PathSolver:
             pt = self._record(u_new, lam_new, st.energy, its, inst, "target" if is_target and nxt != lam_end else "step")
             sol.path.append(pt)
             self.eq.commit(u_new)
-            self._detect(sol)
             self._emit(sol, pt)
             u_prev, lam_prev, u, lam = u, lam, u_new, lam_new
-            if abs(lam - lam_end) <= 1e-12 * abs(lam_end):
+            if abs(lam - lam_end) <= 1e-12 * abs(lam_end) or self._far(pt):
                 return
             growth = np.clip(np.sqrt(opt.desired_iterations / max(its, 1)), 0.5, opt.max_growth)
             dlam = step * growth if abs(step) >= abs(dlam) * 0.999 else dlam
@@ -397,20 +417,41 @@ class PathSolver:
                 if abs(s - lam_end) <= 1e-12 * abs(lam_end):
                     pt.kind = "step"
                     self.eq.commit(u_t)
-                    self._detect(sol)
                     return
+            last = sol.path[-1].instability
+            if opt.refine_critical and last is not None and inst is not None and inst != last:
+                sol.path += self._bracket(u, lam, dl, du_prev, dlam_prev, last)
             pt = self._record(u_new, lam_new, st.energy, its, inst, "step")
             sol.path.append(pt)
             eq.commit(u_new)
-            self._detect(sol)
             self._emit(sol, pt, dl)
             du_prev, dlam_prev = u_new - u, lam_new - lam
             u, lam = u_new, lam_new
-            if (lam - lam_end) * sgn_end > 0:            # beyond the end without a landing
+            if (lam - lam_end) * sgn_end > 0 or self._far(pt):   # beyond the end without a landing
                 return
             dl = float(np.clip(dl * np.sqrt(opt.desired_iterations / max(its, 1)), dl / 2,
                                min(dl * opt.max_growth, dl_max)))
         raise _Failed(f"the path needed more than max_steps={opt.max_steps} steps (reached load factor {lam:.6g})")
+
+    def _bracket(self, u, lam, dl, du_prev, dlam_prev, inst_a):
+        """Bisect the arc length from the stable side (u, lam) towards a change of stability;
+        returns the new path points in path order (stable side first)."""
+        a_side, b_side = [], []
+        dlc = dl
+        for _ in range(self.opt.refine_critical):
+            dlc /= 2
+            try:
+                uh, lh, ih, sth, insth = self._arc_step(u, lam, dlc, du_prev, dlam_prev)
+            except (_Failed, SolverError):
+                break
+            pt = self._record(uh, lh, sth.energy, ih, insth, "refine")
+            if insth == inst_a:
+                a_side.append(pt)
+                self.eq.commit(uh)
+                du_prev, dlam_prev, u, lam = uh - u, lh - lam, uh, lh
+            else:
+                b_side.append(pt)
+        return a_side + b_side[::-1]
 
     def _arc_step(self, u, lam, dl, du_prev, dlam_prev):
         """One Crisfield step of arc length dl; returns (u, lam, iterations, state, instability)."""
