@@ -7,7 +7,7 @@ import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "graspdef"
 #: lowest first; a module may import graspdef modules of its own layer or of a lower one
-LAYERS = ["errors", "testing", "geometry", "subdivision", "shell", "problem", "solve", "bench", "cli"]
+LAYERS = ["errors", "testing", "geometry", "subdivision", "shell", "axisym", "problem", "solve", "bench", "cli"]
 HEAVY = {"mujoco", "open3d", "viser"}
 
 
