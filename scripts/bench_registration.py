@@ -71,7 +71,8 @@ def main(argv=None) -> dict:
         err = reg.transform @ s.pose
         moved = np.linalg.norm(apply(err, body.vertices) - body.vertices, axis=1).max()
         resid = SurfaceDistance(body).signed(apply(reg.transform, s.points))
-        pose.append({"seed": seed, "rotation_error_deg": float(np.degrees(rotation_angle(err[:3, :3]))),
+        pose.append({"seed": seed,
+                     "rotation_error_deg": float(np.degrees(rotation_angle(err[:3, :3]))),
                      "max_vertex_error_mm": float(moved * 1e3),
                      "residual_rms_mm": float(np.sqrt(np.mean(resid**2)) * 1e3),
                      "residual_over_sigma": float(np.sqrt(np.mean(resid**2)) / NEXTENGINE_SIGMA),
@@ -104,7 +105,8 @@ def main(argv=None) -> dict:
     for k, v in speed.items():
         print(f"  {k:22s} {v['median_s']:.3f} s (min {v['min_s']:.3f}, max {v['max_s']:.3f})")
     for p in pose:
-        print(f"  seed {p['seed']}: {p['rotation_error_deg']:.4f} deg, {p['max_vertex_error_mm']:.4f} mm,"
+        print(f"  seed {p['seed']}: {p['rotation_error_deg']:.4f} deg, "
+              f"{p['max_vertex_error_mm']:.4f} mm,"
               f" residual {p['residual_rms_mm']:.4f} mm = {p['residual_over_sigma']:.3f} sigma")
     for name in ("sphere", "control_mesh_5120"):
         t = tennis[name]

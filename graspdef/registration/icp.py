@@ -22,7 +22,6 @@ Procedure (lengths in metres):
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -182,7 +181,8 @@ def _pca_frame(points: np.ndarray):
     return centre, vt.T  # columns: principal axes, largest first
 
 
-def _initial_candidates(scan: np.ndarray, target_pts: np.ndarray, init) -> list[tuple[str, np.ndarray]]:
+def _initial_candidates(scan: np.ndarray, target_pts: np.ndarray,
+                        init) -> list[tuple[str, np.ndarray]]:
     if isinstance(init, str):
         if init == "identity":
             return [("identity", np.eye(4))]

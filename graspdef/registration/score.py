@@ -24,7 +24,13 @@ from scipy.spatial import cKDTree
 
 from graspdef.geometry import TriMesh, compile_predicate, length_scale, save_ply
 from graspdef.registration.distance import SurfaceDistance
-from graspdef.registration.icp import Registration, RegistrationError, apply, register, rotation_angle
+from graspdef.registration.icp import (
+    Registration,
+    RegistrationError,
+    apply,
+    register,
+    rotation_angle,
+)
 from graspdef.scans.manifest import ply_units, read_surface
 from graspdef.scans.remesh import vertex_normals
 
@@ -154,7 +160,7 @@ def _read(path: Path, declared: str | None, what: str) -> tuple[np.ndarray, np.n
 def score_cli(prediction_path: str | PathLike, scan_path: str | PathLike,
               out_dir: str | PathLike, *, undeformed_path: str | PathLike | None = None,
               prediction_units: str | None = None, scan_units: str | None = None,
-              init: str = "pca", region: str | None = None, surface_offset_mm: float = 0.0,
+              init="pca", region: str | None = None, surface_offset_mm: float = 0.0,
               tukey_k_mm: float = 2.0, max_distance_mm: float | None = None) -> dict:
     """``graspdef score PREDICTION SCAN --out DIR``: register, score and write the run folder.
 
@@ -176,8 +182,9 @@ def score_cli(prediction_path: str | PathLike, scan_path: str | PathLike,
         Length units of the files; default the PLY ``comment units`` line; a declared unit that
         contradicts it is an error.  The undeformed file uses the prediction's units unless it
         states its own.
-    init : str
-        Coarse initialisation (``pca``, ``centroid``, ``identity``).
+    init : str or ndarray (4, 4)
+        Coarse initialisation (``pca``, ``centroid``, ``identity``), or a first guess of the
+        scan -> prediction transform in metres (e.g. the object pose of the MuJoCo scene).
     region : str, optional
         Undeformed region of the surfaces to align on (a predicate of x, y, z, r, rho, theta in
         the prediction file's units, e.g. ``"z < -10"``); the scores are measured everywhere.
@@ -229,7 +236,8 @@ def score_cli(prediction_path: str | PathLike, scan_path: str | PathLike,
                    "undeformed": str(undeformed_path), "undeformed_units": u_units,
                    "scan": str(scan_path), "scan_units": s_units,
                    "n_scan_points": int(len(sv)), "scan_is_mesh": bool(sf.shape[0])},
-        "options": {"init": init, "region": region, "surface_offset_mm": surface_offset_mm,
+        "options": {"init": init if isinstance(init, str) else "given", "region": region,
+                    "surface_offset_mm": surface_offset_mm,
                     "tukey_k_mm": tukey_k_mm, "max_distance_mm": max_distance_mm,
                     "icp": "open3d point-to-plane, Tukey loss"},
         "prediction": {"errors": _stats_mm(ps),

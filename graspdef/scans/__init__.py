@@ -17,11 +17,13 @@ from graspdef.scans.scanner import (
     Scanner,
     SyntheticScan,
     generate_scan,
+    load_generated_scan,
     scan_surface,
     write_scan,
 )
 
 __all__ = ["ControlMeshReport", "Manifest", "NEXTENGINE_SIGMA", "ScanEntry", "Scanner",
-           "SyntheticScan", "control_mesh", "generate_scan", "load_manifest", "load_scan",
+           "SyntheticScan", "control_mesh", "generate_scan", "load_generated_scan",
+           "load_manifest", "load_scan",
            "mid_surface", "ply_units", "read_surface", "scan_entry", "scan_surface",
            "shared_scans_dir", "vertex_normals", "write_scan"]

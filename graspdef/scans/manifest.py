@@ -175,7 +175,8 @@ def read_surface(path: str | PathLike, units: str) -> tuple[np.ndarray, np.ndarr
     except Exception as exc:  # trimesh raises many exception types for unreadable files
         raise MeshError(f"cannot read scan file {path}: {exc}") from exc
     if isinstance(loaded, trimesh.Scene):
-        loaded = loaded.to_geometry() if hasattr(loaded, "to_geometry") else loaded.dump(concatenate=True)
+        loaded = (loaded.to_geometry() if hasattr(loaded, "to_geometry")
+                  else loaded.dump(concatenate=True))
     vertices = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=np.float64)
     faces = np.asarray(getattr(loaded, "faces", None) if isinstance(loaded, trimesh.Trimesh)
                        else np.empty((0, 3)), dtype=np.int64).reshape(-1, 3)

@@ -308,3 +308,19 @@ def generate_scan(scan_id: str, manifest=None, out_dir: str | PathLike | None = 
     scan = scan_surface(recipe_surface(source, manifest), scanner, seed=seed, source=source)
     out = Path(out_dir) if out_dir is not None else manifest.generated_dir
     return write_scan(scan, out / f"{scan_id}.ply")
+
+
+def load_generated_scan(scan_id: str, manifest=None, out_dir: str | PathLike | None = None,
+                        regenerate: bool = False) -> tuple[np.ndarray, dict]:
+    """The points [m] and provenance of a generated scan of the manifest, made from its recipe
+    first if it is not on disk yet (or ``regenerate``)."""
+    from graspdef.scans.manifest import load_manifest, ply_units, read_surface
+
+    manifest = manifest or load_manifest()
+    out = Path(out_dir) if out_dir is not None else manifest.generated_dir
+    path = out / f"{scan_id}.ply"
+    if regenerate or not path.is_file():
+        path = generate_scan(scan_id, manifest, out)
+    points, _ = read_surface(path, ply_units(path) or "m")
+    provenance = json.loads(path.with_suffix(".provenance.json").read_text())
+    return points, provenance

@@ -97,7 +97,8 @@ def test_empty_and_tiny_scans_are_refused(egg):
 def test_unit_mismatch_is_detected_by_size(egg, egg_scan):
     """A millimetre scan declared in metres is 1000 times too large, a metre scan declared in
     mm 1000 times too small: refused, naming the likely conversion."""
-    with pytest.raises(RegistrationError, match="is 10[01][0-9] times the size .* mm declared as m"):
+    with pytest.raises(RegistrationError,
+                       match="is 10[01][0-9] times the size .* mm declared as m"):
         register(egg_scan.points * 1e3, egg)
     with pytest.raises(RegistrationError, match="m declared as mm"):
         register(egg_scan.points * 1e-3, egg)

@@ -1,5 +1,6 @@
 """scans/manifest.toml and the loader: every real scan of ../shared/scans is listed with units,
-frame, licence and source (../shared/scans/SOURCES.md), is read in place and comes back in metres."""
+frame, licence and source (../shared/scans/SOURCES.md), is read in place and comes back in
+metres."""
 import hashlib
 
 import numpy as np

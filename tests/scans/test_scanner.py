@@ -7,7 +7,8 @@ import pytest
 
 from graspdef.errors import ProblemError
 from graspdef.geometry import TriMesh, icosphere, rectangle
-from graspdef.scans import NEXTENGINE_SIGMA, Scanner, generate_scan, read_surface, scan_surface
+from graspdef.scans import (NEXTENGINE_SIGMA, Scanner, generate_scan, load_generated_scan,
+                            read_surface, scan_surface)
 from graspdef.scans.manifest import ply_units
 from graspdef.scans.scanner import write_scan
 
@@ -105,6 +106,14 @@ def test_generate_from_manifest_recipe(tmp_path):
     path = generate_scan("ellipsoid_6views", out_dir=tmp_path)
     assert path == tmp_path / "ellipsoid_6views.ply"
     prov = json.loads(path.with_suffix(".provenance.json").read_text())
+    points, again = load_generated_scan("ellipsoid_6views", out_dir=tmp_path)  # not remade
+    assert again == prov and points.shape == (50_000, 3)
+    pose = np.asarray(prov["pose_source_to_scan"])
+    local = (points - pose[:3, 3]) @ pose[:3, :3]
+    # on the ellipsoid x^2/a^2 + y^2/b^2 + z^2/c^2 = 1 (mm semi-axes 40, 30, 20), up to noise
+    # and the 4-subdivision facets
+    level = np.sqrt(((local / [0.04, 0.03, 0.02]) ** 2).sum(axis=1))
+    assert np.abs(level - 1).max() < 0.05
     assert prov["source"] == "ellipsoid:40,30,20" and prov["seed"] == 2
     assert prov["n_points"] == 50_000 and prov["scanner"]["hole_radius"] == 3e-3
 
