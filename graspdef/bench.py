@@ -84,8 +84,128 @@ def format_table(records: list[dict]) -> str:
     lines = ["| benchmark | reference | graspdef | error | tolerance | control vertices | time [s] |",
              "|---|---|---|---|---|---|---|"]
     for r in records:
-        tol = "report only" if r["tolerance"] is None else f"{100 * r['tolerance']:.1f} %"
-        mark = "" if r["passed"] else " (outside)"
-        lines.append(f"| {r['name']} | {r['reference']:.6g} | {r['value']:.6g} | {100 * r['rel_error']:+.2f} %{mark} "
-                     f"| {tol} | {r['n_control']} | {r['seconds']:.1f} |")
+        tol = r.get("tolerance")
+        tol = "report only" if tol is None else f"{100 * tol:.1f} %"
+        mark = "" if r.get("passed", True) else " (outside)"
+        ref = "–" if r.get("reference") is None else f"{r['reference']:.6g}"
+        err = "–" if r.get("rel_error") is None else f"{100 * r['rel_error']:+.3f} %"
+        lines.append(f"| {r['name']} | {ref} | {r['value']:.6g} | {err}{mark} | {tol} | {r.get('n_control', '–')} "
+                     f"| {r['seconds']:.1f} |")
     return "\n".join(lines)
+
+
+# ---- the nonlinear set: benchmarks/nonlinear/*.toml --------------------------------------------
+
+def _point_quantity(spec, sol, point, expr: str) -> float:
+    """``quantity`` on one path point (same forms as the linear set)."""
+    ls = spec.length_scale
+    mesh = sol.problem.shell.mesh
+    probes = {}
+    for name, pt in sol.problem.probes.items():
+        st, w = sol.problem.evaluator.values(pt.face, np.asarray(pt.bary))
+        probes[name] = {"position": (w @ mesh.vertices[st] / ls).tolist(),
+                        "displacement": (np.asarray(point.probes[name]) / ls).tolist()}
+    return quantity({"probes": probes, "max_displacement": float("nan")}, expr)
+
+
+def balloon_pressure(stretch, C1: float, C2: float) -> np.ndarray:
+    """Thin incompressible Mooney-Rivlin balloon: true pressure p R0 / t0 at stretch lambda,
+    4 C1 (1/l - 1/l^7)(1 + (C2/C1) l^2) (../shared/BENCHMARKS.md 4.2; neo-Hookean: C2 = 0)."""
+    lam = np.asarray(stretch, float)
+    return 4.0 * (C1 / lam - C1 / lam ** 7) * (1.0 + (C2 / C1) * lam ** 2)
+
+
+def _balloon_records(spec, sol, ref, tol, n_control, seconds):
+    from .problem.potentials import FollowerPressure
+    from .shell.volume import EnclosedVolume
+
+    shell = sol.problem.shell
+    mat = shell.material
+    C1, C2 = (mat.C1, mat.C2) if hasattr(mat, "C2") else (mat.mu / 2.0, 0.0)
+    t0 = float(np.asarray(shell.thickness))
+    p_ref = next(ld.p for ld in sol.problem.loads if isinstance(ld, FollowerPressure))
+    vol = EnclosedVolume(shell)
+    V0 = vol.value(shell.rest_positions)
+    R0 = (3.0 * V0 / (4.0 * np.pi)) ** (1.0 / 3.0)
+    scale = R0 / (C1 * t0)                                   # p in units of C1 t0 / R0
+    records = []
+
+    def rec(name, reference, value, tolerance):
+        records.append({"name": f"{spec.name} {name}", "reference": float(reference), "value": float(value),
+                        "rel_error": float((value - reference) / abs(reference)), "tolerance": tolerance,
+                        "passed": bool(abs((value - reference) / reference) <= tolerance), "n_control": n_control,
+                        "seconds": seconds, "source": ref.get("source", ""), "units": "C1 t0 / R0"})
+
+    for p in sol.path[1:]:
+        if p.kind == "refine":
+            continue
+        lam = (vol.value(shell.rest_positions + p.u) / V0) ** (1.0 / 3.0)
+        rec(f"p(stretch={lam:.4f})", balloon_pressure(lam, C1, C2) / C1, p.load_factor * p_ref * scale, tol)
+    params = ref.get("curve_params", {})
+    limits = [cp for cp in sol.critical_points if cp["kind"] == "limit point"]
+    for which, key in (("max", "p_max"), ("min", "p_min")):
+        if key not in params:
+            continue
+        cands = [cp for cp in limits if (cp["instability_after"] > cp["instability_before"]) == (which == "max")]
+        value = cands[0]["load_factor"] * p_ref * scale if cands else float("nan")
+        rec(key, params[key], value, tol)
+        if cands and f"stretch_at_{key}" in params:
+            p = next(pt for pt in sol.path if pt.load_factor == cands[0]["load_factor"])
+            lam = (vol.value(shell.rest_positions + p.u) / V0) ** (1.0 / 3.0)
+            rec(f"stretch_at_{key}", params[f"stretch_at_{key}"], lam, tol)
+    return records
+
+
+def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda m: None) -> list[dict]:
+    """Solve one nonlinear benchmark file; one record per compared point of its path."""
+    from dataclasses import replace
+
+    from .solve.nonlinear import path_options, solve_nonlinear
+
+    t0 = time.perf_counter()
+    spec = load_problem(path)
+    ref = spec.reference
+    opts = path_options(spec.solver)
+    lfs = [float(v) for v in ref.get("load_factors", [])]
+    if lfs:
+        opts = replace(opts, targets=tuple(sorted(set(opts.targets) | set(lfs) - {opts.max_load})))
+    sol = solve_nonlinear(spec.problem, opts, backend=spec.backend,
+                          progress=lambda i: progress(f"    point {i['step']}: load factor {i['load_factor']:.4g}"))
+    seconds = time.perf_counter() - t0
+    n_control = int(spec.problem.shell.mesh.n_real)
+    tol = ref.get("tolerance")
+    if ref.get("curve") == "balloon":
+        return _balloon_records(spec, sol, ref, tol, n_control, seconds)
+    records = []
+    for expr, values in ref.get("values", {}).items():
+        if len(values) != len(lfs):
+            raise ProblemError(f"{path}: [reference.values] {expr} has {len(values)} values for {len(lfs)} load factors")
+        for lf, reference in zip(lfs, values):
+            value = _point_quantity(spec, sol, sol.at(lf), expr)
+            # at an exact zero reference (the rolled-up cantilever's w at f = 1) the error is
+            # relative to the path's largest |reference| of that quantity
+            denom = abs(reference) if reference != 0 else max(abs(v) for v in values)
+            rel = (value - reference) / denom
+            records.append({"name": f"{spec.name} {expr} @ {lf:g}", "reference": float(reference), "value": value,
+                            "rel_error": rel, "tolerance": tol, "passed": bool(tol is None or abs(rel) <= tol),
+                            "n_control": n_control, "seconds": seconds, "source": ref.get("source", ""),
+                            "units": spec.length_unit})
+    return records
+
+
+def run_nonlinear_benchmarks(folder: Path, pattern: str = "*",
+                             progress: Callable[[str], None] = lambda m: None) -> list[dict]:
+    files = sorted(folder.glob("*.toml"))
+    if not files:
+        raise ProblemError(f"no benchmark files (*.toml) in {folder}")
+    records = []
+    for f in files:
+        if not fnmatch.fnmatch(f.stem, pattern):
+            continue
+        progress(f"benchmark {f.stem} ...")
+        rs = run_nonlinear_benchmark(f, progress)
+        worst = max(rs, key=lambda r: abs(r["rel_error"]) if np.isfinite(r["rel_error"]) else np.inf)
+        progress(f"  {f.stem}: {len(rs)} compared points, worst {100 * worst['rel_error']:+.3f} % "
+                 f"({worst['name']}), {worst['seconds']:.1f} s")
+        records += rs
+    return records

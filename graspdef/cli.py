@@ -1,7 +1,7 @@
 """The ``graspdef`` command line.
 
-    graspdef solve PROBLEM.toml --out DIR      solve one problem file, write a run folder
-    graspdef bench linear [--json FILE]        run the linear benchmark set, print the table
+    graspdef solve PROBLEM.toml --out DIR      solve one problem file (linear or nonlinear path)
+    graspdef bench linear|nonlinear|axisym [--json FILE]   run a benchmark set, print the table
 
 Every error a user can cause prints one line ``graspdef: error: ...`` and exits with status 2.
 """
@@ -18,12 +18,13 @@ from .errors import GraspdefError
 EPILOG = """examples:
   graspdef solve benchmarks/plate_ss_uniform.toml --out out/plate
   graspdef bench linear --json out/bench_linear.json
+  graspdef solve benchmarks/nonlinear/cantilever_moment.toml --out out/rollup
+  graspdef bench nonlinear --json out/bench_nonlinear.json
 """
 
 
 def _solve(args: argparse.Namespace) -> int:
     from .problem.config import load_problem
-    from .solve.linear import solve_linear
     from .solve.output import result_record, write_run
 
     t0 = time.perf_counter()
@@ -32,28 +33,66 @@ def _solve(args: argparse.Namespace) -> int:
     shell = spec.problem.shell
     _progress(args, f"shell: {shell.mesh.n_real} control vertices (+{shell.n_control - shell.mesh.n_real} ghosts), "
                     f"{shell.mesh.n_real_faces} faces; set-up {time.perf_counter() - t0:.2f} s")
-    sol = solve_linear(spec.problem, backend=args.backend or spec.backend)
-    _progress(args, "solved: " + ", ".join(f"{k} {v:.2f} s" for k, v in sol.timings.items()))
+    backend = args.backend or spec.backend
+    unit = spec.length_unit
+    stopped = None
+    if spec.solver.get("type", "linear") == "nonlinear":
+        from .solve.nonlinear import PathStopped, path_options, solve_nonlinear
+
+        sol, stopped = None, None
+        try:
+            sol = solve_nonlinear(spec.problem, path_options(spec.solver), backend=backend,
+                                  progress=lambda info: _path_progress(args, info))
+        except PathStopped as exc:
+            sol, stopped = exc.solution, exc
+        _progress(args, f"path: {len(sol.path) - 1} points, {sol.n_factorisations} factorisations, "
+                        f"{sol.timings.get('total', 0.0):.1f} s")
+        for cp in sol.critical_points:
+            _progress(args, f"{cp['kind']} at load factor {cp['load_factor']:.6g} "
+                            f"(negative eigenvalues {cp['instability_before']} -> {cp['instability_after']})")
+    else:
+        from .solve.linear import solve_linear
+
+        sol = solve_linear(spec.problem, backend=backend)
+        _progress(args, "solved: " + ", ".join(f"{k} {v:.2f} s" for k, v in sol.timings.items()))
     out = write_run(args.out, spec, sol, Path(args.problem).read_text())
     rec = result_record(spec, sol)
-    unit = spec.length_unit
     for name, p in rec["probes"].items():
         _progress(args, f"probe {name}: u = [{', '.join(f'{c:.6g}' for c in p['displacement'])}] {unit}")
-    _progress(args, f"max displacement {rec['max_displacement']:.6g} {unit}; wrote {out}/result.json, deformed.ply")
+    files = "result.json, deformed.ply" + (", path.csv" if rec["analysis"] == "nonlinear" else "")
+    _progress(args, f"max displacement {rec['max_displacement']:.6g} {unit}; wrote {out}/ ({files})")
+    if stopped is not None:
+        raise stopped.__class__(f"{stopped} (the converged part of the path is in {out})", stopped.solution)
     return 0
 
 
-def _bench(args: argparse.Namespace) -> int:
-    from .bench import format_table, run_linear_benchmarks
+def _path_progress(args: argparse.Namespace, info: dict) -> None:
+    st = {True: "stable", False: "UNSTABLE", None: "stability n/a"}[info["stable"]]
+    arc = f", arc length {info['arc_length']:.3g}" if "arc_length" in info else ""
+    _progress(args, f"  point {info['step']:4d} ({info['kind']}): load factor {info['load_factor']:.6g}, "
+                    f"{info['iterations']} Newton iterations, {st}{arc}, {info['seconds']:.1f} s")
 
-    records = run_linear_benchmarks(Path(args.dir), pattern=args.only, progress=lambda m: _progress(args, m))
+
+def _bench(args: argparse.Namespace) -> int:
+    from .bench import format_table, run_linear_benchmarks, run_nonlinear_benchmarks
+
+    say = lambda m: _progress(args, m)  # noqa: E731
+    root = Path(args.dir) if args.dir else Path(__file__).resolve().parent.parent / "benchmarks"
+    if args.set == "linear":
+        records = run_linear_benchmarks(root, pattern=args.only, progress=say)
+    elif args.set == "nonlinear":
+        records = run_nonlinear_benchmarks(root / "nonlinear" if not args.dir else root, pattern=args.only, progress=say)
+    else:
+        from .axisym.bench import run_axisym_bench
+
+        records = run_axisym_bench(progress=say)
     print(format_table(records))
     if args.json:
         import json
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps(records, indent=2) + "\n")
+        Path(args.json).write_text(json.dumps(records, indent=2, default=float) + "\n")
         _progress(args, f"wrote {args.json}")
-    failed = [r["name"] for r in records if not r["passed"]]
+    failed = [r["name"] for r in records if not r.get("passed", True)]
     if failed:
         _progress(args, f"outside tolerance: {', '.join(failed)}")
     return 0
@@ -78,10 +117,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--backend", choices=["auto", "pardiso", "superlu"], help="sparse solver")
     s.set_defaults(func=_solve)
     b = sub.add_parser("bench", help="run a benchmark set and print/write the comparison table")
-    b.add_argument("set", choices=["linear"], help="which benchmark set")
+    b.add_argument("set", choices=["linear", "nonlinear", "axisym"], help="which benchmark set")
     b.add_argument("--json", help="write the records to this JSON file")
-    b.add_argument("--dir", default=str(Path(__file__).resolve().parent.parent / "benchmarks"),
-                   help="folder with the benchmark problem files")
+    b.add_argument("--dir", help="folder with the benchmark problem files (default: the repository's "
+                                  "benchmarks/, benchmarks/nonlinear/)")
     b.add_argument("--only", default="*", help="glob of benchmark names to run")
     b.set_defaults(func=_bench)
     return ap

@@ -21,9 +21,10 @@ from ..errors import GraspdefError, ProblemError
 from ..geometry import io as gio
 from ..geometry import primitives as prim
 from ..geometry.regions import compile_predicate
-from ..shell.materials import LinearElastic
+from ..shell.hyperelastic import MATERIALS, PARAMETERS, make_material
 from ..shell.model import Shell
-from .loads import BodyForce, PointLoad, Pressure
+from .loads import BodyForce, EdgeLoad, PointLoad, Pressure
+from .potentials import EdgeMoment, EnclosedGas, FollowerPressure
 from .problem import BACKENDS, Problem, SurfacePoint, locate
 from .supports import KINDS, EdgeSupport, PointSupport, RigidModes
 
@@ -41,6 +42,11 @@ _GEOMETRY = {
     "monkey_saddle": {"half_width", "n", "scale"},
     "mesh": {"path", "units"},
 }
+#: [solver] keys and their kinds ("length" values are converted from the file's length unit)
+_SOLVER = {"backend": "str", "collocation": "int", "type": "str", "method": "str", "steps": "int",
+           "max_load": "float", "targets": "list", "max_steps": "int", "max_iterations": "int", "tol": "float",
+           "min_step": "float", "desired_iterations": "int", "max_growth": "float", "line_search": "bool",
+           "max_probe_displacement": "length", "refine_critical": "int"}
 _LENGTH_KEYS = {"lx", "ly", "center", "a", "b", "c", "radius", "length", "half_width", "scale"}
 
 
@@ -57,6 +63,7 @@ class ProblemSpec:
     backend: str = "auto"
     reference: dict = field(default_factory=dict)
     source: dict = field(default_factory=dict)
+    solver: dict = field(default_factory=dict)
 
 
 def _where(path: str, ctx: str) -> str:
@@ -169,12 +176,25 @@ def load_problem(path: str | Path) -> ProblemSpec:
     mesh = _geometry(doc["geometry"], sp_, ls, p.parent)
 
     mat = doc["material"]
-    _check_keys(mat, {"model", "E", "nu"}, "material", sp_, {"E", "nu"})
-    if mat.get("model", "linear_elastic") != "linear_elastic":
-        raise ProblemError(_where(sp_, f"[material] unknown model {mat['model']!r} (valid: linear_elastic)"))
+    if not isinstance(mat, dict):
+        raise ProblemError(_where(sp_, "[material] must be a table"))
+    model = mat.get("model", "linear_elastic")
+    if model not in MATERIALS:
+        hint = difflib.get_close_matches(str(model), list(MATERIALS), n=1)
+        raise ProblemError(_where(sp_, f"[material] unknown model {model!r}" + (f" (did you mean '{hint[0]}'?)" if hint
+                                        else f" (valid: {', '.join(MATERIALS)})")))
+    units = PARAMETERS[model]
+    _check_keys(mat, set(units) | {"model"}, "material", sp_)
+    params = {}
+    for k, v in mat.items():
+        if k == "model":
+            continue
+        if units[k] == "count":
+            params[k] = _integer(v, k, "material", sp_)
+        else:
+            params[k] = _number(v, k, "material", sp_) * (fs / ls ** 2 if units[k] == "Pa" else 1.0)
     try:
-        material = LinearElastic(_number(mat["E"], "E", "material", sp_) * fs / ls ** 2,
-                                 _number(mat["nu"], "nu", "material", sp_))
+        material = make_material(model, params)
     except ProblemError as exc:
         raise ProblemError(_where(sp_, f"[material] {exc}")) from None
 
@@ -237,13 +257,19 @@ def load_problem(path: str | Path) -> ProblemSpec:
             _check_keys(s, {"kind", "name"}, ctx, sp_)
             supports.append(RigidModes())
         elif kind == "point":
-            _check_keys(s, {"kind", "name", "at", "face", "bary", "directions", "tolerance"}, ctx, sp_)
+            _check_keys(s, {"kind", "name", "at", "face", "bary", "directions", "tolerance", "displacement"}, ctx, sp_)
             dirs = s.get("directions", [[1, 0, 0], [0, 1, 0], [0, 0, 1]])
             if not isinstance(dirs, list) or not dirs:
                 raise ProblemError(_where(sp_, f"[{ctx}] directions must be a list of 3-vectors"))
             d = tuple(tuple(_vector(x, "directions", ctx, sp_)) for x in dirs)
+            disp = None
+            if "displacement" in s:                       # prescribed, per direction, at load factor 1
+                disp = tuple(_vector(s["displacement"], "displacement", ctx, sp_, len(d)) * ls)
             pt = surface_point(s, ctx)
-            supports.append(PointSupport(pt.face, pt.bary, d, s.get("name", ctx)))
+            try:
+                supports.append(PointSupport(pt.face, pt.bary, d, s.get("name", ctx), disp))
+            except ProblemError as exc:
+                raise ProblemError(_where(sp_, f"[{ctx}] {exc}")) from None
         else:
             _check_keys(s, {"kind", "name", "region", "normal"}, ctx, sp_, {"region"})
             reg = s["region"]
@@ -279,8 +305,29 @@ def load_problem(path: str | Path) -> ProblemSpec:
             # density [kg/m^3] and g [m/s^2] are SI whatever the file's length unit (as stated in
             # the README); with consistent units they are taken as they are
             loads.append(BodyForce(_number(ld["density"], "density", ctx, sp_), tuple(_vector(ld["g"], "g", ctx, sp_))))
+        elif kind == "follower_pressure":
+            _check_keys(ld, {"kind", "p"}, ctx, sp_, {"p"})
+            loads.append(FollowerPressure(_number(ld["p"], "p", ctx, sp_) * fs / ls ** 2))
+        elif kind == "gas":
+            _check_keys(ld, {"kind", "p0", "p_atm"}, ctx, sp_, {"p0"})
+            p_atm = ld.get("p_atm")
+            loads.append(EnclosedGas(_number(ld["p0"], "p0", ctx, sp_) * fs / ls ** 2,
+                                     *(() if p_atm is None else (_number(p_atm, "p_atm", ctx, sp_) * fs / ls ** 2,))))
+        elif kind in ("edge_load", "edge_moment"):
+            keys = {"kind", "region", "force"} if kind == "edge_load" else {"kind", "region", "moment", "axis"}
+            _check_keys(ld, keys | {"name"}, ctx, sp_, keys - {"kind"})
+            if ld["region"] not in preds:
+                hint = difflib.get_close_matches(str(ld["region"]), list(preds), n=1)
+                raise ProblemError(_where(sp_, f"[{ctx}] unknown region {ld['region']!r}" + (f" (did you mean '{hint[0]}'?)" if hint else "")))
+            name = ld.get("name", ld["region"])
+            if kind == "edge_load":             # force per unit length
+                loads.append(EdgeLoad(preds[ld["region"]], tuple(_vector(ld["force"], "force", ctx, sp_) * fs / ls), name))
+            else:                               # moment per unit length = force
+                loads.append(EdgeMoment(preds[ld["region"]], _number(ld["moment"], "moment", ctx, sp_) * fs,
+                                        tuple(_vector(ld["axis"], "axis", ctx, sp_)), name))
         else:
-            raise ProblemError(_where(sp_, f"[{ctx}] unknown load kind {kind!r} (valid: point, pressure, gravity)"))
+            raise ProblemError(_where(sp_, f"[{ctx}] unknown load kind {kind!r} (valid: point, pressure, gravity, "
+                                           "edge_load, edge_moment, follower_pressure, gas)"))
 
     probes = {}
     for i, pr in enumerate(doc.get("probes", [])):
@@ -291,15 +338,40 @@ def load_problem(path: str | Path) -> ProblemSpec:
         probes[pr["name"]] = surface_point(pr, f"probe '{pr['name']}'")
 
     solver = doc.get("solver", {})
-    _check_keys(solver, {"backend", "collocation"}, "solver", sp_)
+    _check_keys(solver, set(_SOLVER), "solver", sp_)
     backend = solver.get("backend", "auto")
     if backend not in BACKENDS:
         raise ProblemError(_where(sp_, f"[solver] unknown backend {backend!r} (valid: {', '.join(BACKENDS)})"))
     ncol = _integer(solver.get("collocation", 2), "collocation", "solver", sp_)
+    opts = {}
+    for k, v in solver.items():
+        kind = _SOLVER[k]
+        if kind == "str":
+            if not isinstance(v, str):
+                raise ProblemError(_where(sp_, f"[solver] {k} must be a string, got {v!r}"))
+            opts[k] = v
+        elif kind == "int":
+            opts[k] = _integer(v, k, "solver", sp_)
+        elif kind == "bool":
+            if not isinstance(v, bool):
+                raise ProblemError(_where(sp_, f"[solver] {k} must be true or false, got {v!r}"))
+            opts[k] = v
+        elif kind == "list":
+            if not isinstance(v, list):
+                raise ProblemError(_where(sp_, f"[solver] {k} must be a list of numbers, got {v!r}"))
+            opts[k] = tuple(_number(x, k, "solver", sp_) for x in v)
+        else:
+            opts[k] = _number(v, k, "solver", sp_) * (ls if kind == "length" else 1.0)
+    if opts.get("type", "linear") not in ("linear", "nonlinear"):
+        raise ProblemError(_where(sp_, f"[solver] type must be \"linear\" or \"nonlinear\", got {opts['type']!r}"))
+    path_keys = set(opts) - {"type", "backend", "collocation"}
+    if opts.get("type", "linear") == "linear" and path_keys:
+        raise ProblemError(_where(sp_, f"[solver] {', '.join(sorted(path_keys))} only apply to type = \"nonlinear\""))
     ref = doc.get("reference", {})
-    _check_keys(ref, {"value", "quantity", "tolerance", "source", "formula"}, "reference", sp_)
+    _check_keys(ref, {"value", "quantity", "tolerance", "source", "formula", "load_factors", "values", "curve",
+                      "curve_params"}, "reference", sp_)
     try:
         problem = Problem(shell, loads, supports, probes, n_collocation=ncol)
     except GraspdefError as exc:
         raise type(exc)(_where(sp_, str(exc))) from None
-    return ProblemSpec(problem, str(doc.get("name", p.stem)), lu, fu, ls, fs, backend, ref, doc)
+    return ProblemSpec(problem, str(doc.get("name", p.stem)), lu, fu, ls, fs, backend, ref, doc, opts)

@@ -100,6 +100,13 @@ class PathOptions:
             raise ProblemError(f"targets must lie between 0 and max_load={self.max_load}, got {self.targets!r}")
 
 
+def path_options(table: dict) -> PathOptions:
+    """PathOptions from a problem file's [solver] table (values already in SI; the keys that are
+    not path options -- type, backend, collocation -- are ignored)."""
+    keys = set(PathOptions.__dataclass_fields__)
+    return PathOptions(**{k: v for k, v in table.items() if k in keys})
+
+
 @dataclass
 class PathPoint:
     """One converged equilibrium of the path."""
