@@ -50,6 +50,7 @@ class PathResult:
     limits: list
     seconds: float
     model_name: str = ""
+    stopped_by: str = ""
 
     @property
     def lam(self):
@@ -217,11 +218,14 @@ def solve_load(model, lam, increments=1, tol=None, maxit=25):
 
 
 def solve_path(model, ds=0.5, max_steps=200, stop=None, ds_max=None, ds_min=1e-6, maxit=10, lam_max=None,
-               target_iterations=4, weight=None, progress=None, refine_limits=True):
+               target_iterations=4, weight=None, progress=None, on_failure="raise", unload_fraction=None):
     """Trace the equilibrium path from the unloaded state with the constant-arc-length method.
 
     ds: first arc-length step (weighted norm, nondimensional); stop(eq) -> True ends the path; lam_max: stop when
-    |Lam| exceeds it.  Returns a PathResult.  Never returns an unconverged point."""
+    |Lam| exceeds it; unload_fraction: stop once past a limit point when Lam < unload_fraction * Lam_limit.
+    on_failure="stop" ends the path at the last converged point when a step cannot be
+    completed even with the smallest step (PathResult.stopped_by holds the error); "raise" raises it.
+    Returns a PathResult.  Never returns an unconverged point."""
     t_start = time.perf_counter()
     d = model.build()
     st = State(d)
@@ -242,9 +246,11 @@ def solve_path(model, ds=0.5, max_steps=200, stop=None, ds_max=None, ds_min=1e-6
     limits = []
     step = 0
     h = ds
+    stopped_by = ""
     while step < max_steps:
         step += 1
         base = st.copy()
+        failed = None
         while True:
             try:
                 its, K, dR = _arc_step(st, base, t, h, w, maxit, step)
@@ -253,8 +259,14 @@ def solve_path(model, ds=0.5, max_steps=200, stop=None, ds_max=None, ds_min=1e-6
                 st = base.copy()
                 h *= 0.5
                 if h < ds_min:
-                    raise SolverError(f"load step {step}: arc-length step fell below {ds_min:g} "
-                                      f"(last failure: {exc})") from None
+                    failed = SolverError(f"load step {step}: arc-length step fell below {ds_min:g} "
+                                         f"(last failure: {exc})")
+                    break
+        if failed is not None:
+            if on_failure == "raise" or step == 1:
+                raise failed
+            stopped_by = str(failed)
+            break
         Kff = K[np.ix_(f, f)]
         A = np.zeros((f.size + 1, f.size + 1))
         A[:-1, :-1] = Kff
@@ -280,12 +292,14 @@ def solve_path(model, ds=0.5, max_steps=200, stop=None, ds_max=None, ds_min=1e-6
             break
         if lam_max is not None and abs(eq.lam) > lam_max:
             break
+        if unload_fraction is not None and limits and eq.lam < unload_fraction * limits[0]["lam"]:
+            break
         if its <= target_iterations - 1:
             h = min(h * 1.5, ds_max)
         elif its > target_iterations + 2:
             h *= 0.6
     return PathResult(points=points, limits=limits, seconds=time.perf_counter() - t_start,
-                      model_name=model.name)
+                      model_name=model.name, stopped_by=stopped_by)
 
 
 def _limit(p0, p1, t0, t1, h, w, s0):

@@ -93,6 +93,8 @@ class Material:
                 return l1, c1, phi, g, H
         bad = ~np.isfinite(dl) | ~np.isfinite(dc) | (np.abs(dl) + np.abs(dc) > 1e-9)
         idx = np.flatnonzero(np.atleast_1d(bad))
-        raise SolverError(f"constitutive relations could not be inverted (Newton for stretch and curvature "
-                          f"did not converge at integration points {idx[:5].tolist()}; the shell energy loses "
-                          f"convexity in (stretch, curvature) under very large bending, thesis Ch. 5)")
+        err = SolverError(f"constitutive relations could not be inverted (Newton for stretch and curvature "
+                          f"did not converge; the shell energy loses convexity in (stretch, curvature) under very "
+                          f"large bending, thesis Ch. 5)")
+        err.points = idx
+        raise err

@@ -23,7 +23,7 @@ def _sphere_nodes(R, angles, fix_edge):
     return nodes
 
 
-def hemisphere_example(case, R_over_t=10.0, gamma=0.1, ring_angle=np.pi / 4, max_piece=0.6, rk_steps=2,
+def hemisphere_example(case, R_over_t=10.0, gamma=0.1, ring_angle=np.pi / 6, max_piece=0.6, rk_steps=1,
                        volume_factor=False, load_basis="deformed"):
     """The thesis's hemisphere (apex up, edge at the equator, z of the edge held, r and phi of the edge free).
 
@@ -47,9 +47,10 @@ def hemisphere_example(case, R_over_t=10.0, gamma=0.1, ring_angle=np.pi / 4, max
     return Model(mat, 1.0, nodes, segs, nl, dl, max_piece=max_piece, rk_steps=rk_steps, name=f"hemisphere_{case}")
 
 
-def _graded_sphere(R, t, material, first_angle, fix_equator, fine=None):
+def _graded_sphere(R, t, material, first_angle, fix_equator, fine=None, max_piece=1.0):
     """Nodes and segments of the upper hemisphere graded toward the pole: pieces of ~ell/12 within one bending
-    length ell = sqrt(R t)/(3(1 - nu^2))^(1/4) (nu = 1/2) of the pole, ~ell/5 up to 6 ell, ~ell/2.5 beyond."""
+    length ell = sqrt(R t)/(3(1 - nu^2))^(1/4) (nu = 1/2) of the pole, ~ell/5 up to 6 ell, ~ell/2.5 beyond, and
+    never longer than max_piece * t (large membrane tension makes long shooting pieces ill-conditioned)."""
     ell = np.sqrt(R * t) / 1.5 ** 0.5
     fine = fine or ell / 12
     s_pole = R * first_angle
@@ -64,12 +65,12 @@ def _graded_sphere(R, t, material, first_angle, fix_equator, fine=None):
     segs = []
     for k in range(len(nodes) - 1):
         L = marks[k + 1] - marks[k]
-        h = sizes[min(k, len(sizes) - 1)]
+        h = min(sizes[min(k, len(sizes) - 1)], max_piece * t)
         segs.append(Segment(k, k + 1, kappa=-1.0 / R, n_sub=max(1, int(np.ceil(L / h)))))
     return nodes, segs
 
 
-def pinched_sphere(R, t, material, F=1.0, contact_radius=None, rk_steps=2):
+def pinched_sphere(R, t, material, F=1.0, contact_radius=None, rk_steps=2, max_piece=1.0):
     """Closed sphere squeezed by two opposite forces of magnitude F (reference load, N) at its poles.
 
     By symmetry the upper hemisphere is modelled: equator node with z and phi held, r free.  A point force on
@@ -80,14 +81,15 @@ def pinched_sphere(R, t, material, F=1.0, contact_radius=None, rk_steps=2):
     a = contact_radius if contact_radius is not None else 0.25 * t
     if not 0 < a < 0.5 * R:
         raise ProblemError(f"contact radius {a} must lie in (0, R/2)")
-    nodes, segs = _graded_sphere(R, t, material, np.arcsin(a / R), (False, True, True), fine=min(a, 0.5 * t))
+    nodes, segs = _graded_sphere(R, t, material, np.arcsin(a / R), (False, True, True), fine=min(a, 0.5 * t),
+                                 max_piece=max_piece)
     return Model(material, t, nodes, segs, [NodalLoad.ring(1, Fz=-F)], [], rk_steps=rk_steps,
                  name="pinched_sphere")
 
 
-def inflated_sphere(R, t, material, p=1.0, rk_steps=2):
+def inflated_sphere(R, t, material, p=1.0, rk_steps=2, max_piece=1.0):
     """Closed sphere under internal pressure p (reference load, Pa; follower).  Upper hemisphere by symmetry."""
-    nodes, segs = _graded_sphere(R, t, material, 0.0, (False, True, True))
+    nodes, segs = _graded_sphere(R, t, material, 0.0, (False, True, True), max_piece=max_piece)
     return Model(material, t, nodes, segs, [], [DistributedLoad(p=p)], rk_steps=rk_steps, name="inflated_sphere")
 
 

@@ -94,9 +94,9 @@ def integrate(material, batch, y, Y, lam, nsteps, store, trajectory=False):
             try:  # fall back to the undeformed guess
                 f, J, fl, st = rhs(material, yy, geom, loads, lam, np.array([np.ones(K), geom[2]]))
             except SolverError as exc:
-                bad = np.flatnonzero(~np.isfinite(yy).all(axis=0))
+                bad = getattr(exc, "points", np.flatnonzero(~np.isfinite(yy).all(axis=0)))
                 raise ShootingError(f"integration step {j + 1}/{nsteps}: {exc}",
-                                    int(bad[0]) if bad.size else None) from None
+                                    int(bad[0]) if len(bad) else None) from None
         new[j, stage] = st
         dY = np.einsum("ijk,jlk->ilk", J, YY)
         dY[:, 6] += fl
@@ -191,9 +191,18 @@ def solve_bvp1(material, batch, X1, X2, u, lam, nsteps, store, tol=1e-10, maxit=
     after maxit shots (used inside the nodal Newton iteration, which carries the remaining correction).  Raises ShootingError naming the worst segment on failure."""
     u = np.array(u, float)
     scale = 1.0 + np.max(np.abs(X2))
+    u_prev, du = None, None
     for it in range(maxit):
-        y1, Y1 = start_states(material, batch, X1, u, lam)
-        y2, Y2, traj = integrate(material, batch, y1, Y1, lam, nsteps, store, trajectory)
+        for cut in range(8):  # backtrack the Newton step if the shot cannot be integrated
+            try:
+                y1, Y1 = start_states(material, batch, X1, u, lam)
+                y2, Y2, traj = integrate(material, batch, y1, Y1, lam, nsteps, store, trajectory)
+                break
+            except ShootingError:
+                if u_prev is None or cut == 7:
+                    raise
+                du = 0.5 * du
+                u = u_prev + du
         e, A = mismatch(batch, y2, Y2, X2)
         err = np.max(np.abs(e), axis=0)
         if np.all(err < tol * scale) or (it == maxit - 1 and not raise_unconverged):
@@ -207,6 +216,7 @@ def solve_bvp1(material, batch, X1, X2, u, lam, nsteps, store, tol=1e-10, maxit=
             lp = u[0, pole]
             f = np.minimum(1.0, 0.5 * lp / np.maximum(np.abs(du[0, pole]), 1e-300))
             du[:, pole] *= f
+        u_prev = u
         u = u + du
     raise ShootingError(f"shooting (BVP.1) did not converge in {maxit} Newton iterations "
                         f"(end mismatch {np.max(err):.3g})", int(np.argmax(err)))
