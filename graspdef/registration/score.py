@@ -31,7 +31,7 @@ from graspdef.registration.icp import (
     register,
     rotation_angle,
 )
-from graspdef.scans.manifest import ply_units, read_surface
+from graspdef.scans.manifest import load_manifest, ply_units, read_surface
 from graspdef.scans.remesh import vertex_normals
 
 MM = 1e3
@@ -168,8 +168,9 @@ def score_cli(prediction_path: str | PathLike, scan_path: str | PathLike,
     ----------
     prediction_path : path
         Predicted surface (e.g. ``deformed.ply`` of ``graspdef solve``), a triangle mesh.
-    scan_path : path
-        The scan: a triangle mesh (its vertices are scored) or a point cloud.
+    scan_path : path or str
+        The scan: a triangle mesh (its vertices are scored) or a point cloud; or the id of a
+        real scan of the manifest (e.g. ``ycb_056_tennis_ball``, read with its stated units).
     out_dir : path
         Run folder to write (replaced if it exists; written only if everything succeeded):
         ``score.json``, ``scan_errors.ply`` (the scan in its own frame and units, with the signed
@@ -206,6 +207,9 @@ def score_cli(prediction_path: str | PathLike, scan_path: str | PathLike,
         non-overlapping or wrongly scaled input; nothing is written then.
     """
     prediction_path, scan_path, out = Path(prediction_path), Path(scan_path), Path(out_dir)
+    if not scan_path.exists() and str(scan_path) in load_manifest().real:
+        entry = load_manifest().real[str(scan_path)]
+        scan_path, scan_units = entry.file(), scan_units or entry.units
     if undeformed_path is None:
         undeformed_path = prediction_path.with_name("undeformed.ply")
         if not undeformed_path.is_file():

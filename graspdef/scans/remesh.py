@@ -143,7 +143,27 @@ def _decimate(scan: TriMesh, n_faces: int) -> TriMesh:
     return TriMesh(np.asarray(out.vertices), np.asarray(out.triangles))
 
 
-def control_mesh(scan: TriMesh, n_faces: int, method: str = "auto"
+def _relax(mesh: TriMesh, scan: TriMesh, iterations: int, step: float = 0.5) -> TriMesh:
+    """Tangential umbrella smoothing, each step projected back onto the scan: evens out the
+    triangles of a decimated mesh (connectivity unchanged)."""
+    from scipy.sparse import coo_matrix
+
+    tm_scan = trimesh.Trimesh(scan.vertices, scan.faces, process=False)
+    e = unique_edges(mesh.faces)
+    n = mesh.n_vertices
+    adj = coo_matrix((np.ones(2 * len(e)), (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])),
+                     shape=(n, n)).tocsr()
+    deg = np.asarray(adj.sum(axis=1)).ravel()
+    v = mesh.vertices.copy()
+    for _ in range(iterations):
+        normal = vertex_normals(TriMesh(v, mesh.faces))
+        d = adj @ v / deg[:, None] - v
+        d -= np.einsum("ij,ij->i", d, normal)[:, None] * normal
+        v = np.asarray(trimesh.proximity.closest_point(tm_scan, v + step * d)[0])
+    return TriMesh(v, mesh.faces)
+
+
+def control_mesh(scan: TriMesh, n_faces: int, method: str = "auto", relax: int = 0
                  ) -> tuple[TriMesh, ControlMeshReport]:
     """A watertight, manifold control mesh with about ``n_faces`` faces from a closed scan.
 
@@ -158,6 +178,12 @@ def control_mesh(scan: TriMesh, n_faces: int, method: str = "auto"
     method : {"auto", "project", "decimate"}
         ``"auto"``: ``"project"`` when ``n_faces`` is an icosphere size and the scan is
         star-shaped, otherwise ``"decimate"``.
+    relax : int
+        Iterations of tangential smoothing projected onto the scan after decimation (0: none).
+        Decimated meshes have slivers (smallest angle 1-2 degrees on the YCB mustard bottle and
+        the LINEMOD duck); 20 iterations raise it to 14-15 degrees but round off sharp features
+        (mustard bottle, 2,000 faces: scan -> mesh max 0.80 -> 2.2 mm; duck, 3,000 faces:
+        0.31 -> 0.94 mm).
 
     Returns
     -------
@@ -191,7 +217,13 @@ def control_mesh(scan: TriMesh, n_faces: int, method: str = "auto"
                 return control_mesh(scan, n_faces, "project")
             except MeshError:
                 pass
-    mesh = _project(scan, int(n_faces)) if method == "project" else _decimate(scan, int(n_faces))
+    if method == "project":
+        mesh = _project(scan, int(n_faces))
+    else:
+        mesh = _decimate(scan, int(n_faces))
+        if relax:
+            mesh = _relax(mesh, scan, int(relax))
+            method = f"decimate+relax{int(relax)}"
     return mesh, _check(mesh, scan, method, euler_scan)
 
 

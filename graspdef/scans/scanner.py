@@ -16,8 +16,10 @@ The model, step by step (all lengths in metres):
 5. an unknown rigid pose: a uniformly random rotation and a random translation (up to
    ``max_translation``) applied to the points.
 
-The result carries its provenance (source, settings, seed, the true pose); :func:`write_scan`
-writes the points as a PLY file with ``<name>.provenance.json`` next to it.
+Optionally (``triangulate=True``) each view's points are meshed as a range image, the way a
+structured-light scanner meshes each view.  The result carries its provenance (source,
+settings, seed, the true pose); :func:`write_scan` writes the points (and triangles) as a PLY
+file with ``<name>.provenance.json`` next to it.
 """
 
 from __future__ import annotations
@@ -113,12 +115,15 @@ class SyntheticScan:
         (``points ≈ R @ x + t`` for surface points x); its inverse is what registration must find.
     provenance : dict
         Source, settings, seed, pose and counts (JSON-serialisable).
+    faces : ndarray, shape (m, 3), int
+        Triangles of the range-image mesh (``triangulate=True``), empty for a point cloud.
     """
 
     points: np.ndarray
     view: np.ndarray
     pose: np.ndarray
     provenance: dict = field(default_factory=dict)
+    faces: np.ndarray = field(default_factory=lambda: np.empty((0, 3), dtype=np.int64))
 
 
 def _sample_surface(mesh: TriMesh, n: int, rng: np.random.Generator):
@@ -165,8 +170,40 @@ def _mesh_digest(mesh: TriMesh) -> str:
     return h.hexdigest()[:16]
 
 
+def _triangulate_views(points: np.ndarray, view: np.ndarray, cameras: np.ndarray,
+                       centre: np.ndarray, max_edge_factor: float = 3.0) -> np.ndarray:
+    """Range-image meshes: each view's points triangulated in its image plane (Delaunay of the
+    perspective projection), triangles with an edge longer than ``max_edge_factor`` times the
+    view's median edge dropped (depth jumps, silhouettes, holes), oriented towards the camera."""
+    from scipy.spatial import Delaunay
+
+    out = []
+    for k, cam in enumerate(cameras):
+        idx = np.flatnonzero(view == k)
+        if idx.size < 3:
+            continue
+        axis = (centre - cam) / np.linalg.norm(centre - cam)
+        helper = np.array([0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+        ex = np.cross(helper, axis)
+        ex /= np.linalg.norm(ex)
+        ey = np.cross(axis, ex)
+        rel = points[idx] - cam
+        depth = rel @ axis
+        uv = np.stack([rel @ ex / depth, rel @ ey / depth], axis=1)
+        tri = Delaunay(uv).simplices
+        p = points[idx][tri]
+        edges = np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2).max(axis=1)
+        tri = tri[edges <= max_edge_factor * np.median(edges)]
+        p = points[idx][tri]
+        normal = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        flip = np.einsum("ij,ij->i", normal, cam - p[:, 0]) < 0
+        tri[flip] = tri[flip][:, ::-1]
+        out.append(idx[tri])
+    return np.concatenate(out).astype(np.int64) if out else np.empty((0, 3), dtype=np.int64)
+
+
 def scan_surface(mesh: TriMesh, scanner: Scanner = Scanner(), seed: int = 0,
-                 source: str = "mesh") -> SyntheticScan:
+                 source: str = "mesh", triangulate: bool = False) -> SyntheticScan:
     """Scan a surface with the scanner model (see the module docstring).
 
     Parameters
@@ -179,6 +216,9 @@ def scan_surface(mesh: TriMesh, scanner: Scanner = Scanner(), seed: int = 0,
         Seed of the random generator: the same seed gives the same scan.
     source : str
         Description of the surface for the provenance (a manifest id or a path).
+    triangulate : bool
+        Also return a mesh: each view's points triangulated as a range image (as a structured-
+        light scanner meshes each view), not fused across views.
 
     Raises
     ------
@@ -220,6 +260,8 @@ def scan_surface(mesh: TriMesh, scanner: Scanner = Scanner(), seed: int = 0,
                            f"n_points = {scanner.n_points}")
     idx = np.sort(rng.choice(idx, size=scanner.n_points, replace=False))
     pts, view = pts[idx], view[idx]
+    faces = _triangulate_views(pts, view, cameras, centre) if triangulate else \
+        np.empty((0, 3), dtype=np.int64)
     if scanner.noise == "isotropic":
         pts = pts + scanner.sigma * rng.standard_normal(pts.shape)
     else:
@@ -245,6 +287,7 @@ def scan_surface(mesh: TriMesh, scanner: Scanner = Scanner(), seed: int = 0,
         "scanner": {k: (list(v) if isinstance(v, tuple) else v)
                     for k, v in asdict(scanner).items()},
         "n_points": int(len(pts)),
+        "n_faces": int(len(faces)),
         "points_per_view": np.bincount(view, minlength=scanner.n_views).tolist(),
         "camera_positions_m": cameras.tolist(),
         "hole_centres_m": holes.tolist(),
@@ -253,15 +296,15 @@ def scan_surface(mesh: TriMesh, scanner: Scanner = Scanner(), seed: int = 0,
         "pose_note": "points = R @ x + t for x on the source surface; registration should "
                      "recover the inverse",
     }
-    return SyntheticScan(pts, view, pose, provenance)
+    return SyntheticScan(pts, view, pose, provenance, faces)
 
 
 def write_scan(scan: SyntheticScan, path: str | PathLike, units: str = "m") -> Path:
-    """Write the scan's points as a PLY point cloud (``comment units``) and its provenance as
-    ``<stem>.provenance.json`` next to it.  Returns the PLY path."""
+    """Write the scan as a PLY point cloud or mesh (``comment units``; per-point ``view``) and
+    its provenance as ``<stem>.provenance.json`` next to it.  Returns the PLY path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    save_ply(path, scan.points, np.empty((0, 3), dtype=np.int64), units=units,
+    save_ply(path, scan.points, scan.faces, units=units,
              vertex_scalars={"view": scan.view.astype(np.float64)})
     prov = dict(scan.provenance, file=path.name, file_units=units)
     path.with_suffix(".provenance.json").write_text(json.dumps(prov, indent=2) + "\n")
@@ -296,6 +339,7 @@ def generate_scan(scan_id: str, manifest=None, out_dir: str | PathLike | None = 
                            + ", ".join(sorted(manifest.generated))) from None
     source = recipe.pop("source")
     seed = int(recipe.pop("seed", 0))
+    triangulate = bool(recipe.pop("triangulate", False))
     settings = {}
     for key, value in recipe.items():
         if key.endswith("_mm"):
@@ -305,7 +349,8 @@ def generate_scan(scan_id: str, manifest=None, out_dir: str | PathLike | None = 
         else:
             settings[key] = value
     scanner = Scanner(**settings)
-    scan = scan_surface(recipe_surface(source, manifest), scanner, seed=seed, source=source)
+    scan = scan_surface(recipe_surface(source, manifest), scanner, seed=seed, source=source,
+                        triangulate=triangulate)
     out = Path(out_dir) if out_dir is not None else manifest.generated_dir
     return write_scan(scan, out / f"{scan_id}.ply")
 

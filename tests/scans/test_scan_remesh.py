@@ -52,6 +52,20 @@ def test_decimate_real_scans(sid, n_faces):
     assert rep.scan_to_mesh_max < 0.01 * diag and rep.mesh_to_scan_max < 0.01 * diag
 
 
+def test_relaxation_removes_slivers_and_stays_checked():
+    """Decimation leaves slivers; 20 relaxation steps (projected onto the scan) raise the smallest
+    angle (duck, 3,000 faces: measured 2.3 -> 14.7 degrees) and the mesh stays a checked
+    watertight manifold within 1 % of the object's size of the scan (measured max 0.94 mm)."""
+    duck = load_scan("linemod_lmo_obj09_duck")
+    plain, before = control_mesh(duck, 3000, "decimate")
+    relaxed, after = control_mesh(duck, 3000, "decimate", relax=20)
+    _independent_checks(relaxed)
+    np.testing.assert_array_equal(relaxed.faces, plain.faces)
+    assert after.min_angle_deg > 10 > 3 > before.min_angle_deg
+    assert after.method == "decimate+relax20"
+    assert after.scan_to_mesh_max < 0.01 * np.linalg.norm(np.ptp(duck.vertices, axis=0))
+
+
 def test_refusals(ball):
     with pytest.raises(MeshError, match="not star-shaped"):
         control_mesh(load_scan("ycb_025_mug"), 1280, "project")  # handle and cavity
