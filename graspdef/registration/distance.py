@@ -23,7 +23,9 @@ class SurfaceDistance:
     """
 
     def __init__(self, mesh: TriMesh):
-        import open3d as o3d
+        from graspdef.registration.icp import _o3d
+
+        o3d = _o3d()
 
         self.mesh = mesh
         self._origin = mesh.vertices.mean(axis=0)

@@ -132,8 +132,13 @@ def check_units(scan_points: np.ndarray, surface: TriMesh, max_ratio: float = 3.
 
 
 def _o3d():
-    import open3d as o3d
-
+    """open3d, imported on first use; a clear error if it is missing or cannot load."""
+    try:
+        import open3d as o3d
+    except (ImportError, OSError) as exc:  # OSError: libusb-1.0.so.0 missing (Debian)
+        raise RegistrationError(
+            f"registration needs open3d ({exc}); install it with `pip install "
+            "open3d-cpu==0.20.0` and, on Debian, `apt-get install libusb-1.0-0`") from exc
     return o3d
 
 

@@ -133,7 +133,11 @@ def _project(scan: TriMesh, n_faces: int) -> TriMesh:
 
 
 def _decimate(scan: TriMesh, n_faces: int) -> TriMesh:
-    import open3d as o3d  # lazy: only this method needs it
+    try:
+        import open3d as o3d  # lazy: only this method needs it
+    except (ImportError, OSError) as exc:  # OSError: libusb-1.0.so.0 missing (Debian)
+        raise MeshError(f"method 'decimate' needs open3d ({exc}); install open3d-cpu==0.20.0 "
+                        "(Debian: libusb-1.0-0), or use method='project'") from exc
 
     om = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(scan.vertices),
                                    o3d.utility.Vector3iVector(scan.faces.astype(np.int32)))

@@ -130,3 +130,11 @@ def test_non_convergence_is_flagged(egg, egg_scan):
                    max_distance=10e-3)
     assert not reg.converged and "not_converged" in reg.flags
     assert reg.last_step[0] > 1e-5
+
+
+def test_missing_open3d_is_a_clear_error(monkeypatch, egg):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "open3d", None)  # import open3d now raises ImportError
+    with pytest.raises(RegistrationError, match="pip install open3d-cpu==0.20.0"):
+        register(egg.vertices, egg)
