@@ -155,7 +155,9 @@ class State:
         X = d.positions(self.x)
         for pn, k in d.pole_piece.items():  # pole height from the pole piece's vertical travel
             X[pn, 1] = X[d.b_idx[k], 1] - (sol["y2"][1, k] - d.X0[pn, 1])
-        traj = sol["traj"]  # (n+1, 6, K)
+        traj = sol["traj"].copy()  # (n+1, 6, K)
+        for pn, k in d.pole_piece.items():  # the pole piece was integrated from the undeformed pole height
+            traj[:, 1, k] += X[pn, 1] - d.X0[pn, 1]
         shape = np.concatenate([traj[:, 0:3, k] for k in range(traj.shape[2])], 0)
         for pn, k in d.pole_piece.items():
             shape = np.vstack([[0.0, X[pn, 1], 0.0], shape]) if k == 0 else shape
