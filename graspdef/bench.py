@@ -177,19 +177,31 @@ def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda
     if ref.get("curve") == "balloon":
         return _balloon_records(spec, sol, ref, tol, n_control, seconds)
     records = []
-    for expr, values in ref.get("values", {}).items():
-        if len(values) != len(lfs):
-            raise ProblemError(f"{path}: [reference.values] {expr} has {len(values)} values for {len(lfs)} load factors")
-        for lf, reference in zip(lfs, values):
+    values = ref.get("values", {})
+    for expr, vals in values.items():
+        if len(vals) != len(lfs):
+            raise ProblemError(f"{path}: [reference.values] {expr} has {len(vals)} values for {len(lfs)} load factors")
+
+    def record(name, reference, value, rel):
+        records.append({"name": f"{spec.name} {name}", "reference": float(reference), "value": float(value),
+                        "rel_error": float(rel), "tolerance": tol, "passed": bool(tol is None or abs(rel) <= tol),
+                        "n_control": n_control, "seconds": seconds, "source": ref.get("source", ""),
+                        "units": spec.length_unit})
+
+    if ref.get("compare", "each") == "vector":
+        # the quantities are the components of one vector (e.g. the tip position): error norm
+        # relative to the reference vector's norm, per load factor
+        for k, lf in enumerate(lfs):
+            pt = sol.at(lf)
+            r = np.array([vals[k] for vals in values.values()])
+            v = np.array([_point_quantity(spec, sol, pt, expr) for expr in values])
+            record(f"|{', '.join(values)}| @ {lf:g}", np.linalg.norm(r), np.linalg.norm(v),
+                   np.linalg.norm(v - r) / np.linalg.norm(r))
+        return records
+    for expr, vals in values.items():
+        for lf, reference in zip(lfs, vals):
             value = _point_quantity(spec, sol, sol.at(lf), expr)
-            # at an exact zero reference (the rolled-up cantilever's w at f = 1) the error is
-            # relative to the path's largest |reference| of that quantity
-            denom = abs(reference) if reference != 0 else max(abs(v) for v in values)
-            rel = (value - reference) / denom
-            records.append({"name": f"{spec.name} {expr} @ {lf:g}", "reference": float(reference), "value": value,
-                            "rel_error": rel, "tolerance": tol, "passed": bool(tol is None or abs(rel) <= tol),
-                            "n_control": n_control, "seconds": seconds, "source": ref.get("source", ""),
-                            "units": spec.length_unit})
+            record(f"{expr} @ {lf:g}", reference, value, (value - reference) / abs(reference))
     return records
 
 

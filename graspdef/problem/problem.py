@@ -12,7 +12,7 @@ from ..shell.model import Shell
 from ..subdivision.evaluate import SurfaceEvaluator, project_point
 from .loads import PointLoad, load_vector
 from .potentials import EnclosedGas, is_potential
-from .supports import check_rigid_modes, constraint_rows, independent_rows, nitsche_matrix
+from .supports import RigidModes, check_rigid_modes, constraint_rows, independent_rows, nitsche_matrix, three_point_supports
 
 
 #: sparse solver back-ends a problem may ask for (graspdef.solve.sparse implements them)
@@ -111,10 +111,21 @@ class Problem:
         """Nitsche terms for rotation-fixed edges, (3 n_control, 3 n_control) sparse."""
         return nitsche_matrix(self.shell, self.supports, self.evaluator)
 
-    def constraints(self, with_targets: bool = False):
+    def constraints(self, with_targets: bool = False, rigid: str = "orthogonal"):
         """C (m, 3 n_control) and row labels (and, ``with_targets``, the prescribed values g (m,)
-        [m] of C u = g at load factor 1); raises SupportError if rigid modes stay free."""
-        C, labels, g = constraint_rows(self.shell, self.supports, self.evaluator, self.n_collocation,
+        [m] of C u = g at load factor 1); raises SupportError if rigid modes stay free.
+
+        ``rigid``: how RigidModes are imposed -- "orthogonal" (u orthogonal to the rest-state
+        rigid modes; linear theory) or "three_point" (a statically determinate 3-2-1 point
+        support, exact at finite rotations; what the nonlinear solver uses)."""
+        supports = self.supports
+        if rigid == "three_point":
+            supports = []
+            for s in self.supports:
+                supports += three_point_supports(self.shell, self.evaluator, s.name) if isinstance(s, RigidModes) else [s]
+        elif rigid != "orthogonal":
+            raise ProblemError(f"rigid must be 'orthogonal' or 'three_point', got {rigid!r}")
+        C, labels, g = constraint_rows(self.shell, supports, self.evaluator, self.n_collocation,
                                        with_targets=True)
         keep = independent_rows(C)
         C, labels, g = C[keep], [labels[i] for i in keep], g[keep]

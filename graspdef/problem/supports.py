@@ -122,6 +122,38 @@ class RigidModes:
 Support = EdgeSupport | PointSupport | RigidModes
 
 
+def three_point_supports(shell: Shell, ev: SurfaceEvaluator, name: str = "rigid_modes") -> list:
+    """A statically determinate 3-2-1 support that removes the six rigid-body motions without
+    restraining any deformation: vertex P1 fixed in x, y, z; P2 (farthest from P1) in the two
+    directions normal to P1P2; P3 (farthest from the line P1P2) normal to the plane P1P2P3.
+    Its reactions vanish for self-equilibrated loads, at any deformation -- unlike the
+    orthogonality to the rest-state rigid modes, which is only a linearisation."""
+    x = np.asarray(shell.vertices, float)
+    faces = shell.mesh.faces[: shell.mesh.n_real_faces]
+    c = x.mean(axis=0)
+    i1 = int(np.argmax(np.linalg.norm(x - c, axis=1)))
+    i2 = int(np.argmax(np.linalg.norm(x - x[i1], axis=1)))
+    e = (x[i2] - x[i1]) / np.linalg.norm(x[i2] - x[i1])
+    rel = x - x[i1]
+    i3 = int(np.argmax(np.linalg.norm(rel - np.outer(rel @ e, e), axis=1)))
+    n = np.cross(e, x[i3] - x[i1])
+    if np.linalg.norm(n) < 1e-9 * np.linalg.norm(x[i2] - x[i1]) ** 2:
+        raise SupportError(f"support '{name}': the surface is degenerate (all vertices on a line)")
+    n /= np.linalg.norm(n)
+    m = np.cross(n, e)
+
+    def at_vertex(v):
+        f = int(np.flatnonzero((faces == v).any(axis=1))[0])
+        bary = tuple(float(b) for b in (faces[f] == v))
+        return f, bary
+
+    out = []
+    for v, dirs in ((i1, ((1.0, 0, 0), (0, 1.0, 0), (0, 0, 1.0))), (i2, (tuple(n), tuple(m))), (i3, (tuple(n),))):
+        f, b = at_vertex(v)
+        out.append(PointSupport(f, b, dirs, f"{name}: vertex {v}"))
+    return out
+
+
 def rigid_modes(x: np.ndarray) -> np.ndarray:
     """Unit-norm rigid-body modes of control points ``x`` as columns, (3 n, 6):
     translations x, y, z then rotations about x, y, z through the centroid."""

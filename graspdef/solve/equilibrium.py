@@ -7,7 +7,8 @@ Total potential energy of the control points x = X + u at load factor lam::
 with the shell's elastic energy E, the Nitsche rotation terms Kb of clamped/symmetry edges
 (constant: they act where rotations are held near zero), the dead loads f and the
 configuration-dependent loads Pi_i (``graspdef.problem.potentials``).  Supports are the linear
-constraints C u = lam g (g non-zero for prescribed displacements).  The load direction is
+constraints C u = lam g (g non-zero for prescribed displacements); rigid-body modes of a free
+body are removed by a statically determinate 3-2-1 point support (exact at finite rotation).  The load direction is
 q(x) = -d(grad Pi)/d lam = f + sum_i load_i(x).
 
 Each linearised step solves the KKT system of the Hessian H (+ rank-one parts, by the Woodbury
@@ -37,6 +38,7 @@ class State:
     hessian: sp.csr_matrix | None
     rank_one: list
     load: np.ndarray
+    internal: np.ndarray | None = None      # elastic forces dE/dx + Kb u (the force scale)
 
 
 class Equilibrium:
@@ -51,7 +53,7 @@ class Equilibrium:
         self.Kb = problem.boundary_stiffness().tocsr()
         self.f = problem.dead_load_vector()
         self.potentials = problem.potentials()
-        self.C, self.labels, self.g = problem.constraints(with_targets=True)
+        self.C, self.labels, self.g = problem.constraints(with_targets=True, rigid="three_point")
         self.m = self.C.shape[0]
         self.kkt = KKTSystem(self.C, backend)
         self._CCt = spla.splu((self.C @ self.C.T).tocsc()) if self.m else None
@@ -75,8 +77,11 @@ class Equilibrium:
         E += 0.5 * float(u @ (self.Kb @ u)) - lam * float(self.f @ u) if self.Kb.nnz else -lam * float(self.f @ u)
         rank_one: list = []
         q = self.f.copy()
+        internal = None
         if order >= 1:
-            grad = grad + (self.Kb @ u if self.Kb.nnz else 0.0) - lam * self.f
+            grad = grad + (self.Kb @ u if self.Kb.nnz else 0.0)
+            internal = grad
+            grad = grad - lam * self.f
             if order == 2 and self.Kb.nnz:
                 H = (H + self.Kb).tocsr()
         for pot in self.potentials:
@@ -89,7 +94,7 @@ class Equilibrium:
                 if t.hessian is not None:
                     H = (H + t.hessian).tocsr()
                 rank_one += t.rank_one
-        return State(float(E), grad, H if order == 2 else None, rank_one, q)
+        return State(float(E), grad, H if order == 2 else None, rank_one, q, internal)
 
     def energy(self, u: np.ndarray, lam: float) -> float:
         return self.evaluate(u, lam, order=0).energy

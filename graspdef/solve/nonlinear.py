@@ -204,8 +204,7 @@ class PathSolver:
 
     def _converged(self, state, u, lam) -> tuple[bool, float]:
         r, mu = self.eq.projected_residual(state.gradient)
-        internal = state.gradient + lam * state.load
-        scale = max(abs(lam) * float(np.linalg.norm(state.load)), float(np.linalg.norm(internal)),
+        scale = max(abs(lam) * float(np.linalg.norm(state.load)), float(np.linalg.norm(state.internal)),
                     float(np.linalg.norm(self.eq.C.T @ mu)) if self.eq.m else 0.0, 1e-300)
         rn = float(np.linalg.norm(r))
         cres = self.eq.constraint_residual(u, lam)
