@@ -20,6 +20,7 @@ EPILOG = """examples:
   graspdef bench linear --json out/bench_linear.json
   graspdef solve benchmarks/nonlinear/cantilever_moment.toml --out out/rollup
   graspdef bench nonlinear --json out/bench_nonlinear.json
+  graspdef score out/ball/deformed.ply ycb_056_tennis_ball --out out/ball_score
 """
 
 
@@ -59,7 +60,7 @@ def _solve(args: argparse.Namespace) -> int:
     rec = result_record(spec, sol)
     for name, p in rec["probes"].items():
         _progress(args, f"probe {name}: u = [{', '.join(f'{c:.6g}' for c in p['displacement'])}] {unit}")
-    files = "result.json, deformed.ply" + (", path.csv" if rec["analysis"] == "nonlinear" else "")
+    files = "result.json, deformed.ply, undeformed.ply" + (", path.csv" if rec["analysis"] == "nonlinear" else "")
     _progress(args, f"max displacement {rec['max_displacement']:.6g} {unit}; wrote {out}/ ({files})")
     if stopped is not None:
         raise stopped.__class__(f"{stopped} (the converged part of the path is in {out})", stopped.solution)
@@ -98,6 +99,20 @@ def _bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _score(args: argparse.Namespace) -> int:
+    from .registration import score_cli
+
+    rec = score_cli(args.prediction, args.scan, args.out, undeformed_path=args.undeformed,
+                    prediction_units=args.prediction_units, scan_units=args.scan_units,
+                    init=args.init, region=args.region, surface_offset_mm=args.surface_offset_mm)
+    print(rec["summary"])
+    if not rec["ok"]:
+        _progress(args, f"the score is flagged ({', '.join(rec.get('flags', [])) or 'see score.json'}); "
+                        f"wrote {args.out}/score.json")
+        return 1
+    return 0
+
+
 def _progress(args: argparse.Namespace, msg: str) -> None:
     if not getattr(args, "quiet", False):
         print(f"[graspdef] {msg}", file=sys.stderr, flush=True)
@@ -123,6 +138,19 @@ def build_parser() -> argparse.ArgumentParser:
                                   "benchmarks/, benchmarks/nonlinear/)")
     b.add_argument("--only", default="*", help="glob of benchmark names to run")
     b.set_defaults(func=_bench)
+    c = sub.add_parser("score", help="register a scan to a predicted surface and score it (score.json)",
+                       description="Rigid registration (open3d ICP) of a scan to a predicted surface; writes "
+                                   "score.json and per-vertex errors, with the undeformed shape as the baseline.")
+    c.add_argument("prediction", help="predicted surface (a run folder's deformed.ply)")
+    c.add_argument("scan", help="scan file or a scans/manifest.toml id (e.g. ycb_056_tennis_ball)")
+    c.add_argument("--out", required=True, help="output folder")
+    c.add_argument("--undeformed", help="undeformed surface (default: undeformed.ply beside the prediction)")
+    c.add_argument("--prediction-units", help="length unit of the prediction file (default: its 'comment units')")
+    c.add_argument("--scan-units", help="length unit of the scan file")
+    c.add_argument("--init", default="pca", choices=["pca", "centroid", "identity"], help="coarse alignment")
+    c.add_argument("--region", help="undeformed region to align on, e.g. 'z < -10' (prediction units)")
+    c.add_argument("--surface-offset-mm", type=float, default=0.0, help="mid-surface to outer-surface offset [mm]")
+    c.set_defaults(func=_score)
     return ap
 
 

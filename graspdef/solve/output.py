@@ -117,8 +117,9 @@ def result_record(spec: ProblemSpec, sol: LinearSolution | NonlinearSolution) ->
 
 
 def write_run(out: str | Path, spec: ProblemSpec, sol: LinearSolution | NonlinearSolution, config_text: str) -> Path:
-    """Write result.json, deformed.ply, the problem file (and path.csv for a nonlinear path)
-    into ``out`` atomically."""
+    """Write result.json, deformed.ply, undeformed.ply (the limit surface at rest: the baseline
+    of scan scores), the problem file (and path.csv for a nonlinear path) into ``out``
+    atomically."""
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
@@ -129,6 +130,8 @@ def write_run(out: str | Path, spec: ProblemSpec, sol: LinearSolution | Nonlinea
         disp = np.linalg.norm(sol.vertex_displacements(), axis=1)
         save_ply(tmp / "deformed.ply", verts, faces, units=spec.length_unit,
                  vertex_scalars={"displacement": disp / spec.length_scale})
+        L = sol.limit_map()
+        save_ply(tmp / "undeformed.ply", L @ sol.problem.shell.mesh.vertices, faces, units=spec.length_unit)
         (tmp / "problem.toml").write_text(config_text)
         if isinstance(sol, NonlinearSolution):
             header, rows = path_rows(spec, sol)
