@@ -65,9 +65,9 @@ def main():
     curves = {}
 
     m, p = trace("edge_couple", args.ring_angle)
-    rot = np.array([q.nodes[1, 2] - m.nodes[1].phi for q in p.points])
+    rot = np.array([abs(q.nodes[1, 2] - m.nodes[1].phi) for q in p.points])
     fig, ax = plt.subplots(figsize=(5.5, 4))
-    curve_plot(ax, rot, p.lam, p.limits, THESIS["edge_couple_limit"], "edge rotation (rad)",
+    curve_plot(ax, rot, p.lam, p.limits, THESIS["edge_couple_limit"], "edge rotation |Δφ| (rad)",
                "Fig. 10: hemisphere with edge couples")
     ax.axvline(THESIS["edge_max_rotation"], color="C3", ls=":", lw=0.8, label="thesis max rotation 3.097")
     ax.legend(fontsize=8)

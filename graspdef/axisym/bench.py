@@ -85,11 +85,11 @@ def run_axisym_bench(progress=None):
     s = time.perf_counter() - t0
     lim = p.limits[0]["lam"] if p.limits else max(p.lam)
     edge = len(m.nodes) - 1
-    rot = max(q.nodes[edge, 2] - m.nodes[edge].phi for q in p.points)
-    note = "turning point where the constitutive relations stop being invertible at the loaded edge (thesis Ch. 5)"
-    out.append(_rec("hemisphere_edge_couple_limit_load", THESIS["edge_couple_limit"], lim, s, note))
+    rot = max(abs(q.nodes[edge, 2] - m.nodes[edge].phi) for q in p.points)
+    out.append(_rec("hemisphere_edge_couple_limit_load", THESIS["edge_couple_limit"], lim, s,
+                    "couple turning the edge inward"))
     out.append(_rec("hemisphere_edge_couple_max_edge_rotation", THESIS["edge_max_rotation"], rot, s,
-                    "path cannot continue past the turning point: " + p.stopped_by[:120]))
+                    "our path ends shortly after the limit point: " + p.stopped_by[:120]))
     say("hemisphere ring load")
     t0 = time.perf_counter()
     m, p = hemisphere_path("ring")

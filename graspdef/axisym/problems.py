@@ -24,10 +24,11 @@ def _sphere_nodes(R, angles, fix_edge):
 
 
 def hemisphere_example(case, R_over_t=10.0, gamma=0.1, ring_angle=np.pi / 6, max_piece=0.6, rk_steps=1,
-                       volume_factor=False, load_basis="deformed"):
+                       volume_factor=False, load_basis="deformed", edge_sense=-1.0):
     """The thesis's hemisphere (apex up, edge at the equator, z of the edge held, r and phi of the edge free).
 
-    case: "edge_couple" (unit couple per radian at the edge, turning the edge outward-down so the shell everts),
+    case: "edge_couple" (unit couple per radian at the edge turning the edge inward, toward the axis -- the sense
+    that reproduces the thesis's limit load 3.363; edge_sense=+1 turns it outward),
     "ring" (downward unit ring force per radian at polar angle ring_angle), "uniform" (downward uniform vertical
     load of unit intensity per unit deformed area, or undeformed area with load_basis="reference")."""
     mat = Material("mooney_rivlin", C1=1.0, gamma=gamma, volume_factor=volume_factor)
@@ -37,7 +38,7 @@ def hemisphere_example(case, R_over_t=10.0, gamma=0.1, ring_angle=np.pi / 6, max
     segs = [Segment(k, k + 1, kappa=-1.0 / R) for k in range(len(nodes) - 1)]
     nl, dl = [], []
     if case == "edge_couple":
-        nl = [NodalLoad(len(nodes) - 1, M=1.0)]
+        nl = [NodalLoad(len(nodes) - 1, M=float(edge_sense))]
     elif case == "ring":
         nl = [NodalLoad(1, V=-1.0)]
     elif case == "uniform":

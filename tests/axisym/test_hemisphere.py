@@ -3,10 +3,11 @@
 Nondimensional as in the thesis (2.81): lengths / t0, C1 = 1, nodal loads per radian of circumference, distributed
 loads / C1.  Thesis limit loads: edge couples 3.363, ring load 0.958, uniform vertical load 0.0156.
 
-What we reproduce (docs/axisym.md): our own limit loads are converged under mesh/step refinement to < 0.2 %;
-they differ from the thesis's numbers by +5.0 % (edge couples), +35 % (uniform load, per unit deformed area) and
-+24 % (ring load at 30 deg, whose position the thesis's text does not give).  The tests assert our converged
-values and the behaviour, not the thesis's numbers.
+What we reproduce (docs/axisym.md): our limit loads are converged under mesh/step refinement to < 0.2 %.  Edge
+couples (turning the edge inward): 3.372 (default) / 3.378 (refined) vs the thesis's 3.363, +0.3 / +0.4 %.
+Uniform load (per unit deformed area): 0.02107 vs 0.0156 (+35 %) and ring load at 30 deg (position not given in
+the thesis's text): 1.189 vs 0.958 (+24 %) are not reproduced; there the tests assert our converged values and the
+behaviour, not the thesis's numbers.
 """
 import numpy as np
 import pytest
@@ -15,20 +16,35 @@ from graspdef.axisym.bench import hemisphere_path
 from graspdef.axisym.material import Material
 
 #: converged values measured with max_piece = 0.3, rk_steps = 2 (4x finer than the default)
-EDGE_FINE = 3.5308
+EDGE_FINE = 3.3776
+EDGE_OUT_FINE = 3.5308
 UNIFORM_FINE = 0.021074
 RING30_FINE = 1.1888
 
 
-def test_edge_couple_turning_point_is_the_section_moment_capacity():
-    """Edge couples: the load rises to a smooth maximum 3.53 (thesis 3.363, +5 %) where the constitutive
-    relations stop being invertible at the loaded edge: det [[phi_ll, phi_lc], [phi_lc, phi_cc]] -> 0 (the
-    thesis's matrix 5.1, Ch. 5), i.e. the truncated energy's bending moment at zero membrane force has a maximum.
-    The path therefore ends there (edge rotation about 1.9 rad, thesis 3.097)."""
+def test_edge_couple_limit_load_matches_thesis():
+    """Edge couples turning the edge inward: smooth limit point at 3.372 (thesis 3.363, +0.26 %; refined 3.378,
+    +0.43 %), stable (no negative eigenvalue) before it and one negative eigenvalue after it.  The path ends soon
+    after the limit, at an edge rotation of 2.2 rad (thesis: 3.097), where the constitutive relations stop being
+    invertible in the strongly bent edge zone (thesis Ch. 5)."""
     m, p = hemisphere_path("edge_couple")
-    lim = p.limits[0]["lam"] if p.limits else max(p.lam)
+    lim = p.limits[0]["lam"]
+    assert lim == pytest.approx(3.363, rel=5e-3)
     assert lim == pytest.approx(EDGE_FINE, rel=3e-3)
-    assert abs(lim - 3.363) / 3.363 == pytest.approx(0.05, abs=0.005)
+    k = int(np.argmax(p.lam))
+    assert all(q.n_negative == 0 for q in p.points[:k]) and p.points[-1].n_negative == 1
+    rot = max(abs(q.nodes[1, 2] - m.nodes[1].phi) for q in p.points)
+    assert 2.0 < rot < 2.5
+
+
+def test_outward_edge_couple_turning_point_is_the_section_moment_capacity():
+    """Edge couples turning the edge outward: the load rises to 3.537 where the constitutive relations stop being
+    invertible at the loaded edge: det [[phi_ll, phi_lc], [phi_lc, phi_cc]] -> 0 (the thesis's matrix 5.1, Ch. 5),
+    i.e. the truncated energy's bending moment at zero membrane force has a maximum.  The path ends there (edge
+    rotation about 1.9 rad)."""
+    m, p = hemisphere_path("edge_couple", edge_sense=1.0)
+    lim = p.limits[0]["lam"] if p.limits else max(p.lam)
+    assert lim == pytest.approx(EDGE_OUT_FINE, rel=3e-3)
     assert "constitutive relations could not be inverted" in p.stopped_by
     edge = p.points[-1].nodes[1]
     rot = edge[2] - m.nodes[1].phi
