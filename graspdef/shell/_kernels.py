@@ -111,3 +111,517 @@ def block_positions(stencils, indptr, cols):
                         hi = mid
                 out[(f * S + s) * S + t] = lo
     return out
+
+
+# ------------------------------------------------------------------------------------------------
+# fused kernels of the energy, gradient and Hessian (energy.ShellEnergy); numpy reference path:
+# ShellEnergy._local with kinematics.strains / strain_jacobian / strain_hessian_contract
+# ------------------------------------------------------------------------------------------------
+@nb.njit(cache=True, parallel=True, fastmath=False)
+def point_strains(x, stencils, D, dstride, rest_a, rest_b):
+    """Surface derivatives y (nf, nq, 5, 3) = sum_s D[f, q, s, K] x[stencils[f, s]] and the strain
+    vector s (nf, nq, 6) of ``kinematics.strains`` at every quadrature point.
+
+    x : (n, 3) control points; stencils : (nf, S); D : (nf|1, nq, S, 5) basis derivatives
+    (dN, ddN), ``dstride`` = 0 when D is shared by all faces; rest_a, rest_b : (nf, nq, 3)."""
+    nf, S = stencils.shape
+    nq = D.shape[1]
+    y = np.empty((nf, nq, 5, 3))
+    s = np.empty((nf, nq, 6))
+    for f in nb.prange(nf):
+        df = f * dstride
+        for q in range(nq):
+            for K in range(5):
+                for a in range(3):
+                    acc = 0.0
+                    for t in range(S):
+                        acc += D[df, q, t, K] * x[stencils[f, t], a]
+                    y[f, q, K, a] = acc
+            a1 = y[f, q, 0]
+            a2 = y[f, q, 1]
+            m0 = a1[1] * a2[2] - a1[2] * a2[1]
+            m1 = a1[2] * a2[0] - a1[0] * a2[2]
+            m2 = a1[0] * a2[1] - a1[1] * a2[0]
+            j = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+            n0, n1, n2 = m0 / j, m1 / j, m2 / j
+            s[f, q, 0] = 0.5 * ((a1[0] * a1[0] + a1[1] * a1[1] + a1[2] * a1[2]) - rest_a[f, q, 0])
+            s[f, q, 1] = 0.5 * ((a2[0] * a2[0] + a2[1] * a2[1] + a2[2] * a2[2]) - rest_a[f, q, 1])
+            s[f, q, 2] = 2.0 * (0.5 * ((a1[0] * a2[0] + a1[1] * a2[1] + a1[2] * a2[2]) - rest_a[f, q, 2]))
+            for i in range(3):
+                c = y[f, q, 2 + i]
+                b = c[0] * n0 + c[1] * n1 + c[2] * n2
+                k = b - rest_b[f, q, i]
+                s[f, q, 3 + i] = 2.0 * k if i == 2 else k
+    return y, s
+
+
+@nb.njit(cache=True, fastmath=False)
+def _point_jacobian(y, J, n):
+    """ds/dy at one point into J (6, 15) (column 3 K + a), as ``kinematics.strain_jacobian``;
+    the unit normal into n (3,); returns the area element |a1 x a2|."""
+    a1 = y[0]
+    a2 = y[1]
+    m0 = a1[1] * a2[2] - a1[2] * a2[1]
+    m1 = a1[2] * a2[0] - a1[0] * a2[2]
+    m2 = a1[0] * a2[1] - a1[1] * a2[0]
+    j = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+    n[0], n[1], n[2] = m0 / j, m1 / j, m2 / j
+    J[:, :] = 0.0
+    for a in range(3):
+        J[0, a] = a1[a]
+        J[1, 3 + a] = a2[a]
+        J[2, a] = a2[a]
+        J[2, 3 + a] = a1[a]
+    for i in range(3):
+        blk = 2 + i
+        fac = 2.0 if i == 2 else 1.0
+        c = y[blk]
+        cn = c[0] * n[0] + c[1] * n[1] + c[2] * n[2]
+        g0 = (c[0] - cn * n[0]) / j                       # d(c.n)/dm = P c / j
+        g1 = (c[1] - cn * n[1]) / j
+        g2 = (c[2] - cn * n[2]) / j
+        for a in range(3):
+            J[3 + i, 3 * blk + a] = fac * n[a]
+        J[3 + i, 0] = fac * (a2[1] * g2 - a2[2] * g1)       # a2 x g
+        J[3 + i, 1] = fac * (a2[2] * g0 - a2[0] * g2)
+        J[3 + i, 2] = fac * (a2[0] * g1 - a2[1] * g0)
+        J[3 + i, 3] = fac * (g1 * a1[2] - g2 * a1[1])       # g x a1
+        J[3 + i, 4] = fac * (g2 * a1[0] - g0 * a1[2])
+        J[3 + i, 5] = fac * (g0 * a1[1] - g1 * a1[0])
+    return j
+
+
+@nb.njit(cache=True, fastmath=False)
+def _skew(v, A):
+    A[0, 0], A[0, 1], A[0, 2] = 0.0, -v[2], v[1]
+    A[1, 0], A[1, 1], A[1, 2] = v[2], 0.0, -v[0]
+    A[2, 0], A[2, 1], A[2, 2] = -v[1], v[0], 0.0
+
+
+@nb.njit(cache=True, fastmath=False)
+def _mm3(A, B, C):
+    """C = A @ B (3 x 3)."""
+    for i in range(3):
+        for k in range(3):
+            C[i, k] = A[i, 0] * B[0, k] + A[i, 1] * B[1, k] + A[i, 2] * B[2, k]
+
+
+@nb.njit(cache=True, fastmath=False)
+def _point_geometric(y, sig, n, j, Hy, A1, A2, Hm, M, M2, PA):
+    """Add the stress (geometric) part sum_i sig_i d2 s_i/dy2 (``kinematics.
+    strain_hessian_contract``) to Hy (15, 15).  The curvature terms are linear in the second
+    derivatives c_i = a_11, a_22, a_12, so their a1-a2 blocks are evaluated once with the
+    weighted sum c = sum_i fac_i sig_{3+i} c_i."""
+    a1 = y[0]
+    a2 = y[1]
+    w0, w1, w2 = sig[3], sig[4], 2.0 * sig[5]
+    c0 = w0 * y[2, 0] + w1 * y[3, 0] + w2 * y[4, 0]
+    c1 = w0 * y[2, 1] + w1 * y[3, 1] + w2 * y[4, 1]
+    c2 = w0 * y[2, 2] + w1 * y[3, 2] + w2 * y[4, 2]
+    cn = c0 * n[0] + c1 * n[1] + c2 * n[2]
+    j2 = j * j
+    cv = (c0, c1, c2)
+    for a in range(3):
+        for b in range(3):
+            h = -cv[a] * n[b] - n[a] * cv[b] + 3.0 * cn * n[a] * n[b]
+            if a == b:
+                h -= cn
+            Hm[a, b] = h / j2
+    _skew(a1, A1)
+    _skew(a2, A2)
+    # H11 = -A2 Hm A2, H22 = -A1 Hm A1, H12 = -[g]x + A2 Hm A1 with g = P c / j
+    _mm3(A2, Hm, M)
+    _mm3(M, A2, M2)
+    for a in range(3):
+        for b in range(3):
+            Hy[a, b] -= M2[a, b]
+    _mm3(M, A1, M2)
+    g0 = (c0 - cn * n[0]) / j
+    g1 = (c1 - cn * n[1]) / j
+    g2 = (c2 - cn * n[2]) / j
+    M2[0, 1] += g2
+    M2[0, 2] -= g1
+    M2[1, 0] -= g2
+    M2[1, 2] += g0
+    M2[2, 0] += g1
+    M2[2, 1] -= g0
+    for a in range(3):
+        for b in range(3):
+            Hy[a, 3 + b] += M2[a, b]
+            Hy[3 + b, a] += M2[a, b]
+    _mm3(A1, Hm, M)
+    _mm3(M, A1, M2)
+    for a in range(3):
+        for b in range(3):
+            Hy[3 + a, 3 + b] -= M2[a, b]
+    # membrane: sig_0 I, sig_1 I on the diagonal blocks, sig_2 I on the a1-a2 blocks
+    for a in range(3):
+        Hy[a, a] += sig[0]
+        Hy[3 + a, 3 + a] += sig[1]
+        Hy[a, 3 + a] += sig[2]
+        Hy[3 + a, a] += sig[2]
+    # c_i - a1 and c_i - a2 blocks: -(P A2)/j and (P A1)/j, weighted by fac_i sig_{3+i}
+    for r in range(2):
+        A = A2 if r == 0 else A1
+        sgn = -1.0 if r == 0 else 1.0
+        for k in range(3):
+            na = n[0] * A[0, k] + n[1] * A[1, k] + n[2] * A[2, k]
+            for a in range(3):
+                PA[a, k] = sgn * (A[a, k] - n[a] * na) / j
+        for i in range(3):
+            blk = 2 + i
+            wi = w0 if i == 0 else (w1 if i == 1 else w2)
+            for a in range(3):
+                for b in range(3):
+                    v = wi * PA[a, b]
+                    Hy[3 * blk + a, 3 * r + b] += v
+                    Hy[3 * r + b, 3 * blk + a] += v
+
+
+@nb.njit(cache=True, parallel=True, fastmath=False)
+def assemble_elements(y, w, dW, ddW, D, Dt, dstride, stencils, order, bstart, cblocks, cstart,
+                      index, grad, bdata, hess):
+    """Gradient and (if ``hess``) Hessian of sum_q w_q W(s(y_q)) of every face, added in place
+    into ``grad`` (n, 3) and ``bdata`` (9 nnzb): the 3x3 blocks of a :class:`~energy.BlockPattern`,
+    block p's entry (a, b) at 9 p + 3 a + b (``BlockPattern`` positions them in its scalar CSR).
+
+    y : (nf, nq, 5, 3) surface derivatives; w : (nf, nq) weights; dW (nf, nq, 6), ddW
+    (nf, nq, 6, 6) derivatives of the density; D : (nf|1, nq, S, 5) and Dt = D transposed to
+    (nf|1, nq, 5, S4), zero-padded to S4 = a multiple of 4 >= S; ``dstride`` 0 when shared.  Per point the Hessian with respect to y is
+    Hy = J^T (w ddW) J + sum_i w dW_i d2 s_i/dy2 (15 x 15), and the element matrix
+    sum_q (D_q x I3)^T Hy_q (D_q x I3) is formed without the (5, 3, 5, 3) intermediates of the
+    numpy path (only the blocks t >= s, mirrored); block (s, t) goes to block position
+    p = index[(f S + s) S + t] of the pattern.
+
+    Faces are visited in ``order``, in blocks (bstart: offsets into order) of one colour
+    (cblocks[cstart[c]:cstart[c + 1]] are the blocks of colour c); blocks of one colour share no
+    control vertex, so they run in parallel without write races, and the sums are the same for
+    any number of threads."""
+    nq = y.shape[1]
+    S = D.shape[2]
+    S4 = Dt.shape[3]
+    ncol = cstart.shape[0] - 1
+    for col in range(ncol):
+        for bi in nb.prange(cstart[col], cstart[col + 1]):
+            blk_id = cblocks[bi]
+            J = np.empty((6, 15))
+            CJ = np.empty((6, 15))
+            Hy = np.empty((15, 15))
+            Hyf = Hy.reshape(225)
+            n = np.empty(3)
+            sig = np.empty(6)
+            gy = np.empty(15)
+            ge = np.empty((S, 3))
+            T = np.empty((nq, S, 45))
+            out = np.empty(S * 3 * 3 * S4)
+            A1 = np.empty((3, 3))
+            A2 = np.empty((3, 3))
+            Hm = np.empty((3, 3))
+            M = np.empty((3, 3))
+            M2 = np.empty((3, 3))
+            PA = np.empty((3, 3))
+            for k in range(bstart[blk_id], bstart[blk_id + 1]):
+                f = order[k]
+                df = f * dstride
+                ge[:, :] = 0.0
+                for q in range(nq):
+                    wq = w[f, q]
+                    for i in range(6):
+                        sig[i] = dW[f, q, i] * wq
+                    j = _point_jacobian(y[f, q], J, n)
+                    for m in range(15):
+                        acc = 0.0
+                        for i in range(6):
+                            acc += sig[i] * J[i, m]
+                        gy[m] = acc
+                    for s in range(S):
+                        for a in range(3):
+                            acc = 0.0
+                            for K in range(5):
+                                acc += D[df, q, s, K] * gy[3 * K + a]
+                            ge[s, a] += acc
+                    if not hess:
+                        continue
+                    for i in range(6):
+                        for m in range(15):
+                            acc = 0.0
+                            for l in range(6):
+                                acc += (ddW[f, q, i, l] * wq) * J[l, m]
+                            CJ[i, m] = acc
+                    Hy[:, :] = 0.0
+                    for i in range(6):
+                        for m in range(15):
+                            jv = J[i, m]
+                            for mm in range(15):
+                                Hy[m, mm] += jv * CJ[i, mm]
+                    _point_geometric(y[f, q], sig, n, j, Hy, A1, A2, Hm, M, M2, PA)
+                    # T[q, s, (a, L, b)] = sum_K D[s, K] Hy[3K + a, 3L + b]
+                    for s in range(S):
+                        Tq = T[q, s]
+                        Tq[:] = 0.0
+                        for K in range(5):
+                            d = D[df, q, s, K]
+                            for jj in range(45):
+                                Tq[jj] += d * Hyf[45 * K + jj]
+                for s in range(S):
+                    v = stencils[f, s]
+                    for a in range(3):
+                        grad[v, a] += ge[s, a]
+                if not hess:
+                    continue
+                # out[s, a, b, t] = sum_q sum_L T[q, s, (a, L, b)] D[q, t, L] for t >= s, in
+                # register blocks of 3 (b) x 4 (t)
+                for s in range(S):
+                    for a in range(3):
+                        r0 = (s * 3 + a) * 3 * S4
+                        for t0 in range((s // 4) * 4, S4, 4):
+                            c0 = 0.0
+                            c1 = 0.0
+                            c2 = 0.0
+                            c3 = 0.0
+                            d0 = 0.0
+                            d1 = 0.0
+                            d2 = 0.0
+                            d3 = 0.0
+                            e0 = 0.0
+                            e1 = 0.0
+                            e2 = 0.0
+                            e3 = 0.0
+                            for q in range(nq):
+                                for L in range(5):
+                                    j0 = 15 * a + 3 * L
+                                    tv = T[q, s, j0]
+                                    uv = T[q, s, j0 + 1]
+                                    wv = T[q, s, j0 + 2]
+                                    x0 = Dt[df, q, L, t0]
+                                    x1 = Dt[df, q, L, t0 + 1]
+                                    x2 = Dt[df, q, L, t0 + 2]
+                                    x3 = Dt[df, q, L, t0 + 3]
+                                    c0 += tv * x0
+                                    c1 += tv * x1
+                                    c2 += tv * x2
+                                    c3 += tv * x3
+                                    d0 += uv * x0
+                                    d1 += uv * x1
+                                    d2 += uv * x2
+                                    d3 += uv * x3
+                                    e0 += wv * x0
+                                    e1 += wv * x1
+                                    e2 += wv * x2
+                                    e3 += wv * x3
+                            o = r0 + t0
+                            out[o] = c0
+                            out[o + 1] = c1
+                            out[o + 2] = c2
+                            out[o + 3] = c3
+                            o += S4
+                            out[o] = d0
+                            out[o + 1] = d1
+                            out[o + 2] = d2
+                            out[o + 3] = d3
+                            o += S4
+                            out[o] = e0
+                            out[o + 1] = e1
+                            out[o + 2] = e2
+                            out[o + 3] = e3
+                base_f = f * S * S
+                for s in range(S):
+                    # diagonal block symmetrised; off-diagonal block (s, t) and its transpose (t, s)
+                    p = 9 * index[base_f + s * S + s]
+                    for a in range(3):
+                        for b in range(3):
+                            bdata[p + 3 * a + b] += 0.5 * (out[((s * 3 + a) * 3 + b) * S4 + s]
+                                                           + out[((s * 3 + b) * 3 + a) * S4 + s])
+                    for t in range(s + 1, S):
+                        p = 9 * index[base_f + s * S + t]
+                        pt = 9 * index[base_f + t * S + s]
+                        for a in range(3):
+                            for b in range(3):
+                                v = out[((s * 3 + a) * 3 + b) * S4 + t]
+                                bdata[p + 3 * a + b] += v
+                                bdata[pt + 3 * b + a] += v
+
+
+@nb.njit(cache=True, parallel=True)
+def gather(src, idx):
+    """src[idx] (1-D), in parallel."""
+    out = np.empty(idx.shape[0])
+    for k in nb.prange(idx.shape[0]):
+        out[k] = src[idx[k]]
+    return out
+
+
+# ------------------------------------------------------------------------------------------------
+# thickness-integrated hyperelastic density (hyperelastic._ThicknessIntegrated.density), per point
+# ------------------------------------------------------------------------------------------------
+#: material kinds of density_points
+NEO_HOOKEAN, MOONEY_RIVLIN, EXPONENTIAL, COMPRESSIBLE_NEO_HOOKEAN = 0, 1, 2, 3
+
+
+@nb.njit(cache=True, fastmath=False)
+def _incompressible_psi(kind, par, p, q):
+    """psi(c, d) and derivatives of the incompressible laws (hyperelastic._Incompressible._psi)."""
+    d = 1.0 + p + q
+    c = 2.0 + p
+    inv_d = 1.0 / d
+    i1 = (p * p + p * q - q) * inv_d
+    pq = p + q
+    i2 = (pq * pq - q) * inv_d
+    W11 = 0.0
+    W12 = 0.0
+    W22 = 0.0
+    if kind == NEO_HOOKEAN:
+        W = 0.5 * par[0] * i1
+        W1 = 0.5 * par[0]
+        W2 = 0.0
+    elif kind == MOONEY_RIVLIN:
+        W = par[0] * i1 + par[1] * i2
+        W1 = par[0]
+        W2 = par[1]
+    else:                                                   # EXPONENTIAL: C0 (exp[C1 i1] - 1)
+        a = par[1] * i1
+        W1 = par[0] * par[1] * np.exp(a)
+        W = par[0] * np.expm1(a)
+        W2 = 0.0
+        W11 = par[1] * W1
+    inv_d2 = inv_d * inv_d
+    I2d = 1.0 - c * inv_d2
+    pc = W1 + W2 * inv_d
+    pd = -W1 * inv_d2 + W2 * I2d
+    pcc = W11 + 2.0 * W12 * inv_d + W22 * inv_d2
+    pcd = -W11 * inv_d2 + W12 * (I2d - inv_d2 * inv_d) + W22 * inv_d * I2d - W2 * inv_d2
+    pdd = (W11 * inv_d2 * inv_d2 - 2.0 * W12 * inv_d2 * I2d + W22 * I2d * I2d
+           + 2.0 * inv_d2 * inv_d * (W1 + W2 * c))
+    return W, pc, pd, pcc, pcd, pdd
+
+
+@nb.njit(cache=True, fastmath=False)
+def _compressible_psi(par, p, q, tol_eps, max_iter):
+    """Compressible neo-Hookean psi with C33 from plane stress (hyperelastic.
+    CompressibleNeoHookean._psi / _log_c33); the last value is False if Newton did not converge."""
+    mu, lam = par[0], par[1]
+    log_d = np.log1p(p + q)
+    u = -lam * log_d / (2.0 * mu + lam)
+    if log_d < 0.0:
+        u = min(u, np.log1p(-lam * log_d / (2.0 * mu)))
+    ok = not np.isfinite(log_d)
+    tol = tol_eps * (1.0 + abs(log_d))
+    for _ in range(max_iter):
+        f = 2.0 * mu * np.expm1(u) + lam * (log_d + u)
+        du = -f / (2.0 * mu * np.exp(u) + lam)
+        u = u + du
+        if abs(du) <= tol * (1.0 + abs(u)):
+            ok = True
+            break
+    d = 1.0 + p + q
+    L = log_d + u
+    psi = 0.5 * mu * (p + np.expm1(u) - L) + 0.125 * lam * L * L
+    pc = 0.5 * mu
+    pd = (0.5 * lam * L - mu) / (2.0 * d)
+    m = 2.0 * mu + lam - lam * L
+    pdd = (m * m - lam * lam) / (4.0 * d * d * m)
+    return psi, pc, pd, 0.0, 0.0, pdd, ok
+
+
+@nb.njit(cache=True, parallel=True, fastmath=False)
+def density_points(kind, par, s, ri, half, xg, wg, order, tol_eps, max_iter):
+    """Energy per unit rest area W (n,) and, for order >= 1 / 2, dW/ds (n, 6) and d2W/ds2
+    (n, 6, 6) of a thickness-integrated hyperelastic material at n points; the compiled
+    counterpart of ``hyperelastic._ThicknessIntegrated._density_numpy`` (same formulas).
+
+    kind : NEO_HOOKEAN (par = mu), MOONEY_RIVLIN (C1, C2), EXPONENTIAL (C0, C1),
+    COMPRESSIBLE_NEO_HOOKEAN (mu, lam); s (n, 6) strains; ri (n, 3) contravariant rest metric;
+    half (n,) half the rest thickness; xg, wg Gauss-Legendre points and weights on [-1, 1].
+    An inverted point (d <= 0 somewhere in the thickness) gets W = inf and NaN derivatives.
+    Returns (W, dW, ddW, converged): ``converged`` False if a plane-stress Newton solve failed."""
+    n = s.shape[0]
+    ng = xg.shape[0]
+    W = np.empty(n)
+    dW = np.empty((n, 6)) if order >= 1 else np.empty((0, 6))
+    ddW = np.empty((n, 6, 6)) if order >= 2 else np.empty((0, 6, 6))
+    conv = np.ones(n, np.bool_)
+    for i in nb.prange(n):
+        A11, A22, A12 = ri[i, 0], ri[i, 1], ri[i, 2]
+        det_inv = A11 * A22 - A12 * A12
+        gc0, gc1, gc2 = 2.0 * A11, 2.0 * A22, 2.0 * A12
+        h = half[i]
+        Wacc = 0.0
+        G = np.zeros((2, 3))
+        Hm = np.zeros((3, 6))
+        gc = np.empty(3)
+        gd = np.empty(3)
+        hg = np.empty(6)
+        gc[0], gc[1], gc[2] = gc0, gc1, gc2
+        bad = False
+        for ig in range(ng):
+            x = xg[ig]
+            hx = h * x
+            v1 = s[i, 0] - hx * s[i, 3]
+            v2 = s[i, 1] - hx * s[i, 4]
+            v3 = s[i, 2] - hx * s[i, 5]
+            p = 2.0 * (A11 * v1 + A22 * v2 + A12 * v3)
+            q = det_inv * (4.0 * v1 * v2 - v3 * v3)
+            gd[0] = 4.0 * v2 * det_inv + gc0
+            gd[1] = 4.0 * v1 * det_inv + gc1
+            gd[2] = -2.0 * v3 * det_inv + gc2
+            if 1.0 + p + q <= 0.0:
+                bad = True
+                p = 0.0
+                q = 0.0
+            if kind == COMPRESSIBLE_NEO_HOOKEAN:
+                psi, pc, pd, pcc, pcd, pdd, ok = _compressible_psi(par, p, q, tol_eps, max_iter)
+                if not ok:
+                    conv[i] = False
+            else:
+                psi, pc, pd, pcc, pcd, pdd = _incompressible_psi(kind, par, p, q)
+            w = wg[ig]
+            Wacc += w * psi
+            if order >= 1:
+                wx = w * x
+                for c in range(3):
+                    gr = pc * gc[c] + pd * gd[c]
+                    G[0, c] += w * gr
+                    G[1, c] += wx * gr
+            if order >= 2:
+                for jj in range(6):
+                    a = 0 if jj == 0 or jj == 3 or jj == 4 else (1 if jj == 1 or jj == 5 else 2)
+                    b = 0 if jj == 0 else (1 if jj == 1 or jj == 3 else 2)
+                    hd = 0.0
+                    if jj == 2:
+                        hd = -2.0 * det_inv
+                    elif jj == 3:
+                        hd = 4.0 * det_inv
+                    hg[jj] = (pcc * (gc[a] * gc[b]) + pcd * (gc[a] * gd[b] + gd[a] * gc[b])
+                              + pdd * (gd[a] * gd[b]) + pd * hd)
+                wx = w * x
+                wxx = w * x * x
+                for jj in range(6):
+                    Hm[0, jj] += w * hg[jj]
+                    Hm[1, jj] += wx * hg[jj]
+                    Hm[2, jj] += wxx * hg[jj]
+        h2 = h * h
+        if bad:
+            W[i] = np.inf
+        else:
+            W[i] = h * Wacc
+        if order >= 1:
+            for c in range(3):
+                dW[i, c] = np.nan if bad else h * G[0, c]
+                dW[i, 3 + c] = np.nan if bad else -(h2 * G[1, c])
+        if order >= 2:
+            for blk in range(3):
+                # M0 = h Hm0, M1 = -h^2 Hm1, M2 = h^3 Hm2 in [[M0, M1], [M1, M2]]
+                for a in range(3):
+                    for b in range(3):
+                        jj = a if a == b else (3 if a + b == 1 else (4 if a + b == 2 else 5))
+                        if blk == 0:
+                            v = h * Hm[0, jj]
+                            ddW[i, a, b] = np.nan if bad else v
+                        elif blk == 1:
+                            v = -(h2 * Hm[1, jj])
+                            ddW[i, a, 3 + b] = np.nan if bad else v
+                            ddW[i, 3 + a, b] = np.nan if bad else v
+                        else:
+                            v = (h2 * h) * Hm[2, jj]
+                            ddW[i, 3 + a, 3 + b] = np.nan if bad else v
+    return W, dW, ddW, conv

@@ -2,19 +2,100 @@
 
 E(x) = sum_faces sum_q w_q J_q W(s(y(x)))  with y linear in the control points x (n_control, 3).
 Gradient and Hessian apply the chain rule through ``kinematics``; the Hessian is assembled into a
-3x3-block sparse matrix through an index map built once (np.bincount scatter, no COO sort).
-The linear problem is this Hessian at the rest state.
+3x3-block sparse matrix through an index map built once.  The linear problem is this Hessian at
+the rest state.
+
+Two implementations of the same sums:
+
+* the compiled path (``energy``, ``gradient``, ``hessian``): ``_kernels.point_strains`` gives
+  y and the strains, the material's ``density`` (numpy) their energy density and derivatives,
+  and ``_kernels.assemble_elements`` forms per quadrature point the 15 x 15 Hessian with respect
+  to y and contracts it with the basis derivatives, writing straight into the CSR data (faces in
+  spatially compact blocks, blocks coloured so that blocks of one colour share no control
+  vertex and run in parallel);
+* the numpy reference path (``_local``, used by the ``_*_reference`` methods and the tests),
+  through ``kinematics.strain_jacobian`` / ``strain_hessian_contract`` and
+  ``_kernels.material_hessian_blocks``.
 """
 from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
 
-from ._kernels import block_positions, material_hessian_blocks, scatter_blocks
+from ._kernels import (
+    assemble_elements,
+    block_positions,
+    gather,
+    material_hessian_blocks,
+    point_strains,
+    scatter_blocks,
+)
 from .kinematics import strain_hessian_contract, strain_jacobian, strains
 from .model import Shell, surface_derivatives
 
 _CHUNK = 8192
+
+#: faces per block of the compiled assembly (blocks of one colour run in parallel)
+_BLOCK = 128
+
+
+def _morton_order(points: np.ndarray) -> np.ndarray:
+    """Permutation sorting points (n, 3) along a Z-order (Morton) curve of 2^10 cells per axis."""
+    lo = points.min(0)
+    ext = float((points.max(0) - lo).max())
+    cell = np.clip(((points - lo) / (ext if ext > 0 else 1.0) * 1023.0).astype(np.int64), 0, 1023)
+
+    def spread(v):                                   # 10 bits -> every third of 30 bits
+        v = (v | (v << 16)) & 0x030000FF
+        v = (v | (v << 8)) & 0x0300F00F
+        v = (v | (v << 4)) & 0x030C30C3
+        return (v | (v << 2)) & 0x09249249
+
+    code = spread(cell[:, 0]) | (spread(cell[:, 1]) << 1) | (spread(cell[:, 2]) << 2)
+    return np.argsort(code, kind="stable")
+
+
+class _Schedule:
+    """Parallel schedule of one face group: faces in Morton order of their stencil centroids, cut
+    into blocks of ``_BLOCK`` faces; blocks greedily coloured so that two blocks of one colour
+    share no control vertex (their element matrices touch disjoint rows)."""
+
+    def __init__(self, stencils: np.ndarray, x0: np.ndarray):
+        nf = len(stencils)
+        self.order = _morton_order(x0[stencils].mean(1)).astype(np.int64)
+        nb = max(1, -(-nf // _BLOCK))
+        self.bstart = np.minimum(np.arange(nb + 1) * _BLOCK, nf).astype(np.int64)
+        block_of = np.empty(nf, np.int64)
+        block_of[self.order] = np.arange(nf) // _BLOCK
+        S = stencils.shape[1]
+        inc = sp.csr_matrix((np.ones(nf * S, np.int8), (np.repeat(block_of, S), stencils.ravel())),
+                            shape=(nb, int(stencils.max()) + 1 if nf else 1))
+        inc.data[:] = 1
+        adj = (inc.astype(np.int32) @ inc.T.astype(np.int32)).tocsr()
+        colour = np.full(nb, -1, np.int64)
+        for b in range(nb):                          # greedy, in curve order
+            used = colour[adj.indices[adj.indptr[b]:adj.indptr[b + 1]]]
+            c = 0
+            taken = set(used[used >= 0].tolist())
+            while c in taken:
+                c += 1
+            colour[b] = c
+        self.cblocks = np.argsort(colour, kind="stable").astype(np.int64)
+        self.cstart = np.searchsorted(colour[self.cblocks], np.arange(colour.max() + 2)).astype(np.int64)
+        self.n_colours = int(colour.max() + 1)
+
+
+class _GroupData:
+    """Contiguous basis derivatives of one face group for the kernels and its schedule."""
+
+    def __init__(self, g, x0: np.ndarray):
+        self.stencils = np.ascontiguousarray(g.stencils, dtype=np.int64)
+        self.D = np.ascontiguousarray(np.concatenate([g.dN, g.ddN], axis=-1), dtype=float)   # (f|1, q, S, 5)
+        S = self.D.shape[2]
+        self.Dt = np.zeros(self.D.shape[:2] + (5, -(-S // 4) * 4))                          # (f|1, q, 5, S4)
+        self.Dt[..., :S] = np.swapaxes(self.D, -1, -2)
+        self.dstride = 0 if g.dN.shape[0] == 1 else 1
+        self.schedule = _Schedule(self.stencils, x0)
 
 
 class BlockPattern:
@@ -70,6 +151,8 @@ class ShellEnergy:
     def __init__(self, shell: Shell):
         self.shell = shell
         self._pattern: BlockPattern | None = None
+        self._gdata: list[_GroupData] | None = None
+        self._to_csr: np.ndarray | None = None
 
     @property
     def pattern(self) -> BlockPattern:
@@ -113,12 +196,75 @@ class ShellEnergy:
             He = material_hessian_blocks(np.ascontiguousarray(Dc), J, ddW * w[..., None, None], dstride)
         return (w * W).sum(), ge, He
 
+    # -------------------------------------------------------------------- compiled path
+    @property
+    def _groups(self) -> list[_GroupData]:
+        if self._gdata is None:
+            x0 = np.asarray(self.shell.rest_positions, dtype=float)
+            self._gdata = [_GroupData(g, x0) for g in self.shell.basis.groups]
+        return self._gdata
+
+    def _points(self, x: np.ndarray, order: int):
+        """Per group: (group data, rest group, y, W, dW, ddW) at control points x; dW, ddW may be
+        None below ``order`` 1, 2 (materials with ``_evaluate`` compute only what is asked)."""
+        x = np.ascontiguousarray(x, dtype=float).reshape(self.shell.n_control, 3)
+        mat = self.shell.material
+        evaluate = getattr(mat, "_evaluate", None)
+        for gd, r in zip(self._groups, self.shell.rest):
+            y, s = point_strains(x, gd.stencils, gd.D, gd.dstride, r.rest_a, r.rest_b)
+            if evaluate is not None:
+                W, dW, ddW = evaluate(s, r.rest_inv, r.thickness, order)
+            else:
+                W, dW, ddW = mat.density(s, r.rest_inv, r.thickness)
+            yield gd, r, y, W, dW, ddW
+
+    def _assemble(self, x: np.ndarray, hess: bool):
+        E = 0.0
+        grad = np.zeros((self.shell.n_control, 3))
+        pat = self.pattern if hess else None
+        bdata = np.zeros(9 * pat.nnzb) if hess else np.zeros(1)
+        empty = np.zeros(1, np.int64)
+        for gi, (gd, r, y, W, dW, ddW) in enumerate(self._points(x, 2 if hess else 1)):
+            E += (r.weights * W).sum()
+            dW = np.ascontiguousarray(dW, dtype=float)
+            ddW = np.ascontiguousarray(ddW, dtype=float) if hess else np.zeros((1, 1, 6, 6))
+            sc = gd.schedule
+            assemble_elements(y, np.ascontiguousarray(r.weights, dtype=float), dW, ddW, gd.D, gd.Dt,
+                              gd.dstride, gd.stencils, sc.order, sc.bstart, sc.cblocks, sc.cstart,
+                              pat.maps[gi] if hess else empty, grad, bdata, hess)
+        return float(E), grad, bdata
+
+    def _csr(self, bdata: np.ndarray) -> sp.csr_matrix:
+        """CSR matrix of the pattern from its blocks (block p's entry (a, b) at 9 p + 3 a + b)."""
+        p = self.pattern
+        if self._to_csr is None:
+            pos = (p.base[:, None, None] + np.arange(3)[:, None] * p.stride[:, None, None]
+                   + np.arange(3)).ravel()                    # CSR position of (p, a, b)
+            inv = np.empty_like(pos)
+            inv[pos] = np.arange(len(pos))
+            self._to_csr = inv
+        data = gather(bdata, self._to_csr)
+        return sp.csr_matrix((data, p.scalar_indices, p.scalar_indptr), shape=(3 * p.n, 3 * p.n))
+
     def energy(self, x: np.ndarray) -> float:
         """Total elastic energy [J] at control points ``x`` (n_control, 3) [m]."""
-        return float(sum(self._local(g, r, sl, x, 0) for g, r, sl in self._chunks()))
+        return float(sum((r.weights * W).sum() for _, r, _, W, _, _ in self._points(x, 0)))
 
     def gradient(self, x: np.ndarray) -> tuple[float, np.ndarray]:
         """Energy and gradient (3 n_control,) [N]."""
+        E, grad, _ = self._assemble(x, False)
+        return E, grad.ravel()
+
+    def hessian(self, x: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
+        """Energy, gradient and Hessian (3 n_control, 3 n_control) [N/m] at ``x``."""
+        E, grad, bdata = self._assemble(x, True)
+        return E, grad.ravel(), self._csr(bdata)
+
+    # -------------------------------------------------------------------- numpy reference path
+    def _energy_reference(self, x: np.ndarray) -> float:
+        return float(sum(self._local(g, r, sl, x, 0) for g, r, sl in self._chunks()))
+
+    def _gradient_reference(self, x: np.ndarray) -> tuple[float, np.ndarray]:
         E = 0.0
         grad = np.zeros((self.shell.n_control, 3))
         for g, r, sl in self._chunks():
@@ -127,8 +273,7 @@ class ShellEnergy:
             np.add.at(grad, g.stencils[sl], ge)
         return float(E), grad.ravel()
 
-    def hessian(self, x: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
-        """Energy, gradient and Hessian (3 n_control, 3 n_control) [N/m] at ``x``."""
+    def _hessian_reference(self, x: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
         E = 0.0
         grad = np.zeros((self.shell.n_control, 3))
         blocks: list[list] = [[] for _ in self.shell.basis.groups]

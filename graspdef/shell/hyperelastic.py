@@ -30,6 +30,7 @@ material from a name and a parameter table, for problem files.
 from __future__ import annotations
 
 import difflib
+import functools
 import math
 from collections.abc import Mapping
 from dataclasses import MISSING, dataclass, fields
@@ -37,6 +38,13 @@ from dataclasses import MISSING, dataclass, fields
 import numpy as np
 
 from ..errors import ProblemError, SolverError
+from ._kernels import (
+    COMPRESSIBLE_NEO_HOOKEAN,
+    EXPONENTIAL,
+    MOONEY_RIVLIN,
+    NEO_HOOKEAN,
+    density_points,
+)
 from .materials import LinearElastic
 
 __all__ = ["NeoHookean", "MooneyRivlin", "Exponential", "CompressibleNeoHookean",
@@ -55,6 +63,15 @@ _BLOCKS = np.block([[_SYM, _SYM + 6], [_SYM + 6, _SYM + 12]]).ravel()
 
 _EPS = np.finfo(float).eps
 _NEWTON_MAX = 60
+
+
+@functools.lru_cache(maxsize=None)
+def _gauss(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre points and weights on [-1, 1] (read-only)."""
+    xg, wg = np.polynomial.legendre.leggauss(n)
+    xg.flags.writeable = False
+    wg.flags.writeable = False
+    return xg, wg
 
 
 # ------------------------------------------------------------------------------------------------
@@ -143,6 +160,12 @@ def _pq_grad_d(v, A11, A22, A12, det_inv, grad_c):
     return p, q, r
 
 
+def _rows(a: np.ndarray, shape: tuple, n: int) -> np.ndarray:
+    """(..., k) broadcast to shape + (k,), as a contiguous (k, n) array of component rows."""
+    k = a.shape[-1]
+    return np.ascontiguousarray(np.broadcast_to(a, shape + (k,)).reshape(n, k).T)
+
+
 # ------------------------------------------------------------------------------------------------
 # common thickness integration
 # ------------------------------------------------------------------------------------------------
@@ -155,6 +178,11 @@ class _ThicknessIntegrated:
 
     def _prepare(self, p: np.ndarray, q: np.ndarray):
         """Per-point data needed by _psi (the solved C33 for compressible laws)."""
+        return None
+
+    def _kind(self):
+        """(kind, parameters) of the compiled density kernel, or None (a subclass not known to
+        ``_kernels.density_points``: the numpy path is used)."""
         return None
 
     def density(self, s: np.ndarray, rest_inv: np.ndarray, thickness: np.ndarray):
@@ -179,55 +207,98 @@ class _ThicknessIntegrated:
         ddW : (..., 6, 6) array
             d^2W/ds^2, symmetric.
         """
+        return self._evaluate(s, rest_inv, thickness, 2)
+
+    def _evaluate(self, s: np.ndarray, rest_inv: np.ndarray, thickness: np.ndarray, order: int):
+        """(W, dW, ddW) of :meth:`density`; dW (order < 1) and ddW (order < 2) may be None.
+        Compiled per point (``_kernels.density_points``) for the materials of this module,
+        otherwise (subclasses) :meth:`_density_numpy`."""
+        kind = self._kind()
+        if kind is None:
+            W, dW, ddW = self._density_numpy(s, rest_inv, thickness)
+            return W, (dW if order >= 1 else None), (ddW if order >= 2 else None)
         s = np.asarray(s, dtype=float)
         rest_inv = np.asarray(rest_inv, dtype=float)
         t = np.asarray(thickness, dtype=float)
         shape = np.broadcast_shapes(s.shape[:-1], rest_inv.shape[:-1], t.shape)
-        t = np.broadcast_to(t, shape)
-        e, k = s[..., :3], s[..., 3:]
+        n = math.prod(shape)
+        sf = np.ascontiguousarray(np.broadcast_to(s, shape + (6,)).reshape(n, 6))
+        rf = np.ascontiguousarray(np.broadcast_to(rest_inv, shape + (3,)).reshape(n, 3))
+        half = 0.5 * np.broadcast_to(t, shape).reshape(n)
+        xg, wg = _gauss(self.n_thickness)
+        W, dW, ddW, conv = density_points(kind[0], np.asarray(kind[1], dtype=float), sf, rf, half,
+                                          xg, wg, order, 8.0 * _EPS, _NEWTON_MAX)
+        if not conv.all():
+            raise SolverError(
+                f"compressible neo-Hookean: plane-stress condition dpsi/dC33 = 0 not converged in "
+                f"{_NEWTON_MAX} Newton steps at {int((~conv).sum())} point(s)")
+        return (W.reshape(shape), dW.reshape(shape + (6,)) if order >= 1 else None,
+                ddW.reshape(shape + (6, 6)) if order >= 2 else None)
+
+    def _density_numpy(self, s: np.ndarray, rest_inv: np.ndarray, thickness: np.ndarray):
+        """:meth:`density` in numpy, for any subclass implementing ``_psi`` (the reference of the
+        compiled path; the tests compare the two)."""
+        s = np.asarray(s, dtype=float)
+        rest_inv = np.asarray(rest_inv, dtype=float)
+        t = np.asarray(thickness, dtype=float)
+        shape = np.broadcast_shapes(s.shape[:-1], rest_inv.shape[:-1], t.shape)
+        n = math.prod(shape)
+        # component-major layout: every per-point quantity is a contiguous (n,) row, so that the
+        # arithmetic below runs on whole rows (no fancy indexing along a short last axis)
+        sc = _rows(s, shape, n)                                   # (6, n)
+        ri = _rows(rest_inv, shape, n)                            # (3, n)
+        half = 0.5 * np.broadcast_to(t, shape).reshape(n)
         xg, wg = np.polynomial.legendre.leggauss(self.n_thickness)
-        half = 0.5 * t
-        A11, A22, A12 = rest_inv[..., 0], rest_inv[..., 1], rest_inv[..., 2]
+        A11, A22, A12 = ri[0], ri[1], ri[2]
         det_inv = A11 * A22 - A12 * A12
         # symmetric 3 x 3 matrices are handled as their 6 entries (_I[j], _J[j])
-        gc = 2.0 * rest_inv
-        gcI, gcJ = gc[..., _I], gc[..., _J]
-        gcc = gcI * gcJ
-        Hd = det_inv[..., None] * _D2D[_I, _J]
+        gc = 2.0 * ri                                             # (3, n)
+        gcc = [gc[i] * gc[j] for i, j in zip(_I, _J)]
+        Hd = [det_inv * _D2D[i, j] for i, j in zip(_I, _J)]
         ng = len(xg)
-        psi_g = np.empty((ng,) + shape)
-        grad_g = np.empty((ng,) + shape + (3,))
-        hess_g = np.empty((ng,) + shape + (6,))
-        bad = np.zeros(shape, dtype=bool)
-        for i, x in enumerate(xg):
-            v = e - (half * x)[..., None] * k
-            p, q, gd = _pq_grad_d(v, A11, A22, A12, det_inv, gc)
+        psi_g = np.empty((ng, n))
+        grad_g = np.empty((ng, 3, n))
+        hess_g = np.empty((ng, 6, n))
+        bad = np.zeros(n, dtype=bool)
+        gd = np.empty((3, n))
+        for ig, x in enumerate(xg):
+            hx = half * x
+            v1, v2, v3 = sc[0] - hx * sc[3], sc[1] - hx * sc[4], sc[2] - hx * sc[5]
+            p = 2.0 * (A11 * v1 + A22 * v2 + A12 * v3)
+            q = det_inv * (4.0 * v1 * v2 - v3 * v3)
+            np.multiply(4.0 * v2, det_inv, out=gd[0])
+            np.multiply(4.0 * v1, det_inv, out=gd[1])
+            np.multiply(-2.0 * v3, det_inv, out=gd[2])
+            gd += gc
             inverted = 1.0 + p + q <= 0.0
             if inverted.any():
-                bad |= np.broadcast_to(inverted, shape)
+                bad |= inverted
                 p, q = np.where(inverted, 0.0, p), np.where(inverted, 0.0, q)
             psi, pc, pd, pcc, pcd, pdd = self._psi(p, q, self._prepare(p, q))
-            psi_g[i] = psi
-            grad_g[i] = pc[..., None] * gc + pd[..., None] * gd
-            gdI, gdJ = gd[..., _I], gd[..., _J]
-            hess_g[i] = (pcc[..., None] * gcc + pcd[..., None] * (gcI * gdJ + gdI * gcJ)
-                         + pdd[..., None] * (gdI * gdJ) + pd[..., None] * Hd)
+            psi_g[ig] = psi
+            np.multiply(pc, gc, out=grad_g[ig])
+            grad_g[ig] += pd * gd
+            for jj, (i, j) in enumerate(zip(_I, _J)):
+                gci, gcj, gdi, gdj = gc[i], gc[j], gd[i], gd[j]
+                hess_g[ig, jj] = (pcc * gcc[jj] + pcd * (gci * gdj + gdi * gcj)
+                                  + pdd * (gdi * gdj) + pd * Hd[jj])
         # moments sum_g w_g x_g^m (.)_g, m = 0, 1, 2 (one small matrix product each), then the
         # powers of t0/2 from zeta_g = x_g t0/2 and the weight t0/2 of the rule on [-t0/2, t0/2]
         mom = np.stack([wg, wg * xg, wg * xg * xg])
         W = half * np.tensordot(wg, psi_g, axes=(0, 0))
-        G = np.tensordot(mom[:2], grad_g, axes=(1, 0))
-        Hm = np.tensordot(mom, hess_g, axes=(1, 0))
+        G = np.tensordot(mom[:2], grad_g, axes=(1, 0))           # (2, 3, n)
+        Hm = np.tensordot(mom, hess_g, axes=(1, 0))              # (3, 6, n)
         h2 = half * half
-        dW = np.concatenate([half[..., None] * G[0], -(h2[..., None] * G[1])], -1)
-        K = np.concatenate([half[..., None] * Hm[0], -(h2[..., None] * Hm[1]),
-                            (h2 * half)[..., None] * Hm[2]], -1)        # M0, M1, M2 (6 entries each)
-        ddW = np.take(K, _BLOCKS, axis=-1).reshape(shape + (6, 6))   # [[M0, M1], [M1, M2]]
+        dW = np.empty((n, 6))
+        dW[:, :3] = (half * G[0]).T
+        dW[:, 3:] = (-(h2 * G[1])).T
+        K = np.concatenate([half * Hm[0], -(h2 * Hm[1]), (h2 * half) * Hm[2]])   # (18, n): M0, M1, M2
+        ddW = np.ascontiguousarray(np.take(K, _BLOCKS, axis=0).T)     # [[M0, M1], [M1, M2]]
         if bad.any():
             W = np.where(bad, np.inf, W)
-            dW = np.where(bad[..., None], np.nan, dW)
-            ddW = np.where(bad[..., None, None], np.nan, ddW)
-        return W, dW, ddW
+            dW[bad] = np.nan
+            ddW[bad] = np.nan
+        return W.reshape(shape), dW.reshape(shape + (6,)), ddW.reshape(shape + (6, 6))
 
     def tangent(self, rest_inv: np.ndarray, thickness: np.ndarray) -> np.ndarray:
         """Hessian at zero strain, (..., 6, 6): ``blockdiag(t0 H, t0^3/12 H)`` with the plane-stress
@@ -319,6 +390,9 @@ class NeoHookean(_Incompressible):
         z = _const(0.0, i1)
         return 0.5 * self.mu * i1, _const(0.5 * self.mu, i1), z, z, z, z
 
+    def _kind(self):
+        return (NEO_HOOKEAN, (self.mu,)) if type(self) is NeoHookean else None
+
 
 @dataclass(frozen=True)
 class MooneyRivlin(_Incompressible):
@@ -356,6 +430,9 @@ class MooneyRivlin(_Incompressible):
     def _w(self, i1, i2):
         z = _const(0.0, i1)
         return (self.C1 * i1 + self.C2 * i2, _const(self.C1, i1), _const(self.C2, i1), z, z, z)
+
+    def _kind(self):
+        return (MOONEY_RIVLIN, (self.C1, self.C2)) if type(self) is MooneyRivlin else None
 
 
 @dataclass(frozen=True)
@@ -395,6 +472,9 @@ class Exponential(_Incompressible):
         z = _const(0.0, i1)
         W1 = self.C0 * self.C1 * ex
         return self.C0 * np.expm1(a), W1, z, self.C1 * W1, z, z
+
+    def _kind(self):
+        return (EXPONENTIAL, (self.C0, self.C1)) if type(self) is Exponential else None
 
 
 # ------------------------------------------------------------------------------------------------
@@ -480,6 +560,10 @@ class CompressibleNeoHookean(_ThicknessIntegrated):
 
     def _c33(self, p, q):
         return np.exp(self._log_c33(np.log1p(p + q)))
+
+    def _kind(self):
+        return ((COMPRESSIBLE_NEO_HOOKEAN, (self.mu, self.lam))
+                if type(self) is CompressibleNeoHookean else None)
 
     def _prepare(self, p, q):
         log_d = np.log1p(p + q)
