@@ -37,6 +37,7 @@ def test_edge_couple_limit_load_matches_thesis():
     assert 2.0 < rot < 2.5
 
 
+@pytest.mark.slow
 def test_outward_edge_couple_turning_point_is_the_section_moment_capacity():
     """Edge couples turning the edge outward: the load rises to 3.537 where the constitutive relations stop being
     invertible at the loaded edge: det [[phi_ll, phi_lc], [phi_lc, phi_cc]] -> 0 (the thesis's matrix 5.1, Ch. 5),
