@@ -286,7 +286,7 @@ def solve_path(model, ds=0.5, max_steps=200, stop=None, ds_max=None, ds_min=1e-6
         svals.append(svals[-1] + h)
         tangents.append(tn)
         if len(points) >= 2 and t[-1] > 0 >= tn[-1]:
-            limits.append(_limit(points[-2], points[-1], t, tn, h, w, svals[-2]))
+            limits.append(_limit(points[-2], points[-1], t, tn, h, w, svals[-2], step))
         t = tn
         if progress:
             progress(step, eq)
@@ -304,7 +304,7 @@ def solve_path(model, ds=0.5, max_steps=200, stop=None, ds_max=None, ds_min=1e-6
                       model_name=model.name, stopped_by=stopped_by)
 
 
-def _limit(p0, p1, t0, t1, h, w, s0):
+def _limit(p0, p1, t0, t1, h, w, s0, step):
     """Limit point between two converged points: maximum of the cubic Hermite interpolant of Lam(s)."""
     l0, l1, d0, d1 = p0.lam, p1.lam, t0[-1], t1[-1]
     ss = np.linspace(0, 1, 2001)
@@ -312,8 +312,8 @@ def _limit(p0, p1, t0, t1, h, w, s0):
     h01, h11 = -2 * ss**3 + 3 * ss**2, ss**3 - ss**2
     lam = h00 * l0 + h10 * h * d0 + h01 * l1 + h11 * h * d1
     i = int(np.argmax(lam))
-    return dict(lam=float(lam[i]), s=float(s0 + ss[i] * h), step=len(p0.nodes) and None,
-                bracket=(p0.lam, p1.lam), frac=float(ss[i]))
+    return dict(lam=float(lam[i]), s=float(s0 + ss[i] * h), step=int(step), bracket=(float(p0.lam), float(p1.lam)),
+                frac=float(ss[i]))
 
 
 def _arc_step(st, base, t, h, w, maxit, step):
