@@ -14,14 +14,54 @@ antisymmetric in (s, t), so the assembled Hessian is symmetric.
 """
 from __future__ import annotations
 
+import numba as nb
 import numpy as np
 import scipy.sparse as sp
 
 from .energy import BlockPattern
-from .kinematics import skew
 from .model import Shell
 
 _CHUNK = 4096
+
+
+@nb.njit(cache=True, parallel=True)
+def _hessian_blocks(N, dN, p, a1, a2, w, stride):
+    """Blocks [f, s, t, a, b] = [v_st]_x (see the module docstring); N (f|1, q, S),
+    dN (f|1, q, S, 2), p/a1/a2 (f, q, 3), w (q,) including the 1/3."""
+    nf, nq = p.shape[0], p.shape[1]
+    S = N.shape[2]
+    out = np.zeros((nf, S, S, 3, 3))
+    for f in nb.prange(nf):
+        fb = f * stride
+        for s in range(S):
+            for t in range(s + 1, S):
+                v0 = 0.0
+                v1 = 0.0
+                v2 = 0.0
+                for q in range(nq):
+                    Ns, Nt = N[fb, q, s], N[fb, q, t]
+                    d1s, d1t = dN[fb, q, s, 0], dN[fb, q, t, 0]
+                    d2s, d2t = dN[fb, q, s, 1], dN[fb, q, t, 1]
+                    ca2 = w[q] * (d1s * Nt - Ns * d1t)
+                    ca1 = w[q] * (Ns * d2t - d2s * Nt)
+                    cp = w[q] * (d2s * d1t - d1s * d2t)
+                    v0 += ca2 * a2[f, q, 0] + ca1 * a1[f, q, 0] + cp * p[f, q, 0]
+                    v1 += ca2 * a2[f, q, 1] + ca1 * a1[f, q, 1] + cp * p[f, q, 1]
+                    v2 += ca2 * a2[f, q, 2] + ca1 * a1[f, q, 2] + cp * p[f, q, 2]
+                # [v]_x and its transpose (v_ts = -v_st)
+                out[f, s, t, 0, 1] = -v2
+                out[f, s, t, 0, 2] = v1
+                out[f, s, t, 1, 0] = v2
+                out[f, s, t, 1, 2] = -v0
+                out[f, s, t, 2, 0] = -v1
+                out[f, s, t, 2, 1] = v0
+                out[f, t, s, 0, 1] = v2
+                out[f, t, s, 0, 2] = -v1
+                out[f, t, s, 1, 0] = -v2
+                out[f, t, s, 1, 2] = v0
+                out[f, t, s, 2, 0] = v1
+                out[f, t, s, 2, 1] = -v0
+    return out
 
 
 class EnclosedVolume:
@@ -95,12 +135,9 @@ class EnclosedVolume:
                   + np.einsum("fqs,fqd,q->fsd", d1, np.cross(a2, p), w)
                   + np.einsum("fqs,fqd,q->fsd", d2, np.cross(p, a1), w))
             np.add.at(grad, g.stencils[sl], ge)
-            wa2 = a2 * w[None, :, None]
-            wa1 = a1 * w[None, :, None]
-            wp = p * w[None, :, None]
-            A = np.einsum("fqs,fqt,fqd->fstd", d1, N, wa2)
-            B = np.einsum("fqs,fqt,fqd->fstd", N, d2, wa1)
-            Cc = np.einsum("fqs,fqt,fqd->fstd", d2, d1, wp)
-            v = (A - A.transpose(0, 2, 1, 3)) + (B - B.transpose(0, 2, 1, 3)) + (Cc - Cc.transpose(0, 2, 1, 3))
-            blocks[gi_of[id(g)]].append((sl, np.ascontiguousarray(skew(v))))
+            Nr = g.N if g.N.shape[0] == 1 else g.N[sl]
+            dNr = g.dN if g.dN.shape[0] == 1 else g.dN[sl]
+            blk = _hessian_blocks(np.ascontiguousarray(Nr), np.ascontiguousarray(dNr), np.ascontiguousarray(p),
+                                  np.ascontiguousarray(a1), np.ascontiguousarray(a2), w, 0 if g.N.shape[0] == 1 else 1)
+            blocks[gi_of[id(g)]].append((sl, blk))
         return V, grad.ravel(), self.pattern.assemble(blocks)

@@ -189,9 +189,13 @@ class PathSolver:
         self.q_norm = 0.0
 
     # ---------------------------------------------------------------------------------------
-    def _record(self, u, lam, energy, its, inst, kind="step") -> PathPoint:
+    def _record(self, u, lam, state, its, inst, kind="step") -> PathPoint:
         x_u = u.reshape(-1, 3)
-        pt = PathPoint(float(lam), x_u.copy(), float(energy), int(its), inst, kind)
+        pt = PathPoint(float(lam), x_u.copy(), float(state.energy), int(its), inst, kind)
+        if self.eq.m and np.any(self.eq.g):               # reactions of prescribed displacements
+            _, mu = self.eq.projected_residual(state.gradient)
+            for i in np.flatnonzero(self.eq.g):
+                pt.extra[f"reaction[{self.eq.labels[i]}]"] = float(-mu[i])
         ev = self.problem.evaluator
         for name, sp_ in self.problem.probes.items():
             st, w = ev.values(sp_.face, np.asarray(sp_.bary))
@@ -310,14 +314,13 @@ class PathSolver:
             raise ProblemError("the problem has no load: add loads, a prescribed displacement or an enclosed gas")
         try:
             if self.gas:                          # gas pre-load: equilibrium at lam = 0 first
-                u, st, its, inst = self.newton(u, 0.0)
-                energy = st.energy
+                u, st0, its, inst = self.newton(u, 0.0)
             else:
                 inst = self.eq.factor(st0)
-                energy, its = st0.energy, 0
+                its = 0
         except (_Failed, SolverError) as exc:
             raise PathStopped(f"no equilibrium at zero load: {exc}", sol) from None
-        sol.path.append(self._record(u, 0.0, energy, its, inst, "start"))
+        sol.path.append(self._record(u, 0.0, st0, its, inst, "start"))
         self.eq.commit(u)
         try:
             if opt.method == "load":
@@ -372,7 +375,7 @@ class PathSolver:
                 dlam = step / 2
                 continue
             is_target = abs(lam_new - nxt) <= 1e-12 * abs(lam_end)
-            pt = self._record(u_new, lam_new, st.energy, its, inst, "target" if is_target and nxt != lam_end else "step")
+            pt = self._record(u_new, lam_new, st, its, inst, "target" if is_target and nxt != lam_end else "step")
             sol.path.append(pt)
             self.eq.commit(u_new)
             self._emit(sol, pt)
@@ -417,7 +420,7 @@ class PathSolver:
                 except (_Failed, SolverError) as exc:
                     log.info("could not land on load factor %.6g (%s)", s, exc)
                     continue
-                pt = self._record(u_t, s, st_t.energy, its_t, inst_t, "target")
+                pt = self._record(u_t, s, st_t, its_t, inst_t, "target")
                 sol.path.append(pt)
                 self._emit(sol, pt, dl)
                 if abs(s - lam_end) <= 1e-12 * abs(lam_end):
@@ -427,7 +430,7 @@ class PathSolver:
             last = sol.path[-1].instability
             if opt.refine_critical and last is not None and inst is not None and inst != last:
                 sol.path += self._bracket(u, lam, dl, du_prev, dlam_prev, last)
-            pt = self._record(u_new, lam_new, st.energy, its, inst, "step")
+            pt = self._record(u_new, lam_new, st, its, inst, "step")
             sol.path.append(pt)
             eq.commit(u_new)
             self._emit(sol, pt, dl)
@@ -450,7 +453,7 @@ class PathSolver:
                 uh, lh, ih, sth, insth = self._arc_step(u, lam, dlc, du_prev, dlam_prev)
             except (_Failed, SolverError):
                 break
-            pt = self._record(uh, lh, sth.energy, ih, insth, "refine")
+            pt = self._record(uh, lh, sth, ih, insth, "refine")
             if insth == inst_a:
                 a_side.append(pt)
                 self.eq.commit(uh)

@@ -1,0 +1,85 @@
+"""Speed of a nonlinear path: a neo-Hookean rubber sphere (R = 32.5 mm, t = 2.5 mm, E = 1 MPa,
+the paper's tennis-ball dimensions) squeezed by two opposite point forces up to 20 N in 20 load
+steps (issue 3's speed case).  Prints and saves (JSON) the wall time of each run -- set-up,
+path, per-step Newton iterations -- and their median.
+
+    python scripts/bench_nonlinear_speed.py [--subdivisions 5] [--runs 3] [--gas-kpa 0] [--out out/bench_nonlinear_speed.json]
+
+subdivisions 5 gives 10,242 control vertices.  Runs are separate processes (numba's compile
+cache warm, no shared state)."""
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+CHILD = r"""
+import json, sys, time
+t0 = time.perf_counter()
+import numpy as np
+from graspdef.geometry import sphere
+from graspdef.problem.loads import PointLoad
+from graspdef.problem.potentials import EnclosedGas
+from graspdef.problem.problem import Problem
+from graspdef.problem.supports import RigidModes
+from graspdef.shell.hyperelastic import NeoHookean
+from graspdef.shell.model import Shell
+from graspdef.solve.nonlinear import PathOptions, solve_nonlinear
+sub, steps, force, gas = int(sys.argv[1]), int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+t_imp = time.perf_counter()
+R, t = 0.0325, 0.0025
+m = sphere(R, sub)
+shell = Shell(m.vertices, m.faces, NeoHookean(1e6 / 3), t)
+loads = [EnclosedGas(gas * 1e3)] if gas > 0 else []
+pr = Problem(shell, loads, [RigidModes()])
+top, bot = pr.locate((0, 0, R)), pr.locate((0, 0, -R))
+pr.loads += [PointLoad(top.face, top.bary, (0, 0, -force)), PointLoad(bot.face, bot.bary, (0, 0, force))]
+pr.probes["top"] = top
+t_setup = time.perf_counter()
+sol = solve_nonlinear(pr, PathOptions(steps=steps, max_steps=10 * steps))
+t_end = time.perf_counter()
+print(json.dumps({"n_control": int(shell.mesh.n_real), "import_s": t_imp - t0, "setup_s": t_setup - t_imp,
+                  "path_s": t_end - t_setup, "total_s": t_end - t0, "steps": len(sol.path) - 1,
+                  "newton_iterations": sol.iterations(), "factorisations": sol.n_factorisations,
+                  "factor_s": sol.timings["factor"], "solve_s": sol.timings["solve"],
+                  "top_displacement_mm": float(-sol.probe("top")[2] * 1e3)}))
+"""
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--subdivisions", type=int, default=5)
+    ap.add_argument("--steps", type=int, default=20)
+    ap.add_argument("--force", type=float, default=20.0, help="each point force [N]")
+    ap.add_argument("--gas-kpa", type=float, default=0.0, help="initial gauge pressure of enclosed air [kPa]")
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--out", default="out/bench_nonlinear_speed.json")
+    a = ap.parse_args()
+    runs = []
+    for k in range(a.runs):
+        t0 = time.perf_counter()
+        res = subprocess.run([sys.executable, "-c", CHILD, str(a.subdivisions), str(a.steps), str(a.force), str(a.gas_kpa)],
+                             capture_output=True, text=True)
+        if res.returncode:
+            print(res.stderr[-3000:], file=sys.stderr)
+            raise SystemExit(f"run {k + 1} failed")
+        r = json.loads(res.stdout.strip().splitlines()[-1])
+        r["wall_s"] = time.perf_counter() - t0
+        runs.append(r)
+        print(f"run {k + 1}: {r['n_control']} control vertices, path {r['path_s']:.1f} s (set-up {r['setup_s']:.1f} s, "
+              f"factor {r['factor_s']:.1f} s), {r['steps']} steps, Newton iterations {r['newton_iterations']}, "
+              f"pole displacement {r['top_displacement_mm']:.2f} mm", flush=True)
+    med = {k: statistics.median(r[k] for r in runs) for k in ("path_s", "setup_s", "total_s", "factor_s")}
+    print(f"median over {a.runs} runs: path {med['path_s']:.1f} s, set-up {med['setup_s']:.1f} s, "
+          f"total (incl. imports) {med['total_s']:.1f} s")
+    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(a.out).write_text(json.dumps({"case": vars(a), "runs": runs, "median": med}, indent=2) + "\n")
+    print(f"wrote {a.out}")
+
+
+if __name__ == "__main__":
+    main()
