@@ -188,6 +188,9 @@ def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda
                         "n_control": n_control, "seconds": seconds, "source": ref.get("source", ""),
                         "units": spec.length_unit})
 
+    if ref.get("compare", "each") == "curve":
+        _curve_records(spec, sol, ref, lfs, values, record)
+        return records
     if ref.get("compare", "each") == "vector":
         # the quantities are the components of one vector (e.g. the tip position): error norm
         # relative to the reference vector's norm, per load factor
@@ -203,6 +206,41 @@ def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda
             value = _point_quantity(spec, sol, sol.at(lf), expr)
             record(f"{expr} @ {lf:g}", reference, value, (value - reference) / abs(reference))
     return records
+
+
+def _abscissa(point, expr: str, scale: float) -> float:
+    """``reaction.NAME``: the summed reactions of the prescribed-displacement support NAME."""
+    if not expr.startswith("reaction."):
+        raise ProblemError(f"reference abscissa {expr!r}: expected reaction.NAME")
+    name = expr.split(".", 1)[1]
+    vals = [v for k, v in point.extra.items() if k.startswith(f"reaction[{name}:")]
+    if not vals:
+        raise ProblemError(f"reference abscissa {expr!r}: no prescribed displacement named {name!r}")
+    return scale * float(sum(vals))
+
+
+def _curve_records(spec, sol, ref, levels, values, record):
+    """Compare along a displacement-controlled path: at each tabulated abscissa level (e.g. the
+    load P/P_max, from the reactions), the quantities are interpolated linearly on the LAST path
+    segment that crosses the level -- the branch a load-controlled experiment ends on after a
+    snap.  Quantities listed in ``range_normalised`` (those crossing zero) are compared
+    relative to their largest tabulated magnitude, the others pointwise."""
+    scale = float(ref.get("abscissa_scale", 1.0))
+    pts = [p for p in sol.path if p.kind != "refine"]
+    a = np.array([_abscissa(p, ref["abscissa"], scale) for p in pts])
+    q = {expr: np.array([_point_quantity(spec, sol, p, expr) for p in pts]) for expr in values}
+    rn = set(ref.get("range_normalised", []))
+    for k, level in enumerate(levels):
+        cross = np.flatnonzero((a[:-1] - level) * (a[1:] - level) <= 0)
+        for expr, vals in values.items():
+            if not len(cross):
+                record(f"{expr} @ {level:g}", vals[k], float("nan"), float("nan"))
+                continue
+            i = cross[-1]
+            w = 0.0 if a[i + 1] == a[i] else (level - a[i]) / (a[i + 1] - a[i])
+            v = (1 - w) * q[expr][i] + w * q[expr][i + 1]
+            denom = max(abs(x) for x in vals) if expr in rn else abs(vals[k])
+            record(f"{expr} @ {level:g}", vals[k], v, (v - vals[k]) / denom)
 
 
 def run_nonlinear_benchmarks(folder: Path, pattern: str = "*",

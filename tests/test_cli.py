@@ -171,3 +171,61 @@ def test_point_load_by_face_and_barycentric_position(tmp_path, capsys):
     code, err, out2 = _run(tmp_path, BASE, capsys, name="q.toml")
     w_at = json.loads((out2 / "result.json").read_text())["probes"]["centre"]["displacement"][2]
     assert w_fb == pytest.approx(w_at, rel=1e-9)
+
+
+NONLINEAR = BASE.replace("""[material]
+E = 1000.0
+nu = 0.3""", """[material]
+model = "neo_hookean"
+mu = 333.3""").replace("force = [0.0, 0.0, -1.0]", "force = [0.0, 0.0, -20.0]") + """
+[solver]
+type = "nonlinear"
+steps = 4
+"""
+
+
+def test_solve_nonlinear_writes_the_path(tmp_path, capsys):
+    """A nonlinear problem file: progress per converged point, path.csv with one row per point
+    (start included) and a result.json that says so; the plate under a large central force
+    deflects less than linear theory predicts (membrane stiffening)."""
+    f = tmp_path / "p.toml"
+    f.write_text(NONLINEAR)
+    assert main(["solve", str(f), "--out", str(tmp_path / "run")]) == 0
+    err = capsys.readouterr().err
+    assert "Newton iterations" in err and "path:" in err
+    rec = json.loads((tmp_path / "run" / "result.json").read_text())
+    assert rec["analysis"] == "nonlinear" and rec["completed"] and rec["stable"]
+    rows = (tmp_path / "run" / "path.csv").read_text().strip().splitlines()
+    assert rows[0].startswith("point,kind,load_factor") and "centre_uz[mm]" in rows[0]
+    assert len(rows) == rec["n_points"] + 1 and float(rows[-1].split(",")[2]) == 1.0
+    lin = tmp_path / "lin.toml"
+    lin.write_text(NONLINEAR.replace('type = "nonlinear"\nsteps = 4', 'type = "linear"'))
+    assert main(["solve", str(lin), "--out", str(tmp_path / "lin")]) == 0
+    w_lin = json.loads((tmp_path / "lin" / "result.json").read_text())["probes"]["centre"]["displacement"][2]
+    w_nl = rec["probes"]["centre"]["displacement"][2]
+    assert 0 < w_nl / w_lin < 1
+
+
+def test_a_stopped_path_keeps_its_converged_part_and_exits_2(tmp_path, capsys):
+    f = tmp_path / "p.toml"
+    f.write_text(NONLINEAR.replace("steps = 4", "steps = 50\nmax_steps = 2"))
+    assert main(["solve", str(f), "--out", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err
+    assert "max_steps" in err and "converged part" in err
+    rec = json.loads((tmp_path / "run" / "result.json").read_text())
+    assert not rec["completed"] and rec["load_factor"] < 1 and "max_steps" in rec["stop_reason"]
+
+
+@pytest.mark.parametrize("edit,message", [
+    (('model = "neo_hookean"', 'model = "neo_hooke"'), "did you mean 'neo_hookean'"),
+    (("mu = 333.3", "mu = -1.0"), "mu"),
+    (('type = "nonlinear"', 'type = "nonlinear"\nmethod = "riks"'), "unknown path method"),
+    (('type = "nonlinear"', 'type = "nonlinear"\nstepz = 3'), "did you mean 'steps'"),
+    (('kind = "point"\nat = [0.0, 0.0, 0.0]\nforce', 'kind = "gas"\np0 = 1.0\n#'), "closed surface"),
+])
+def test_nonlinear_bad_input(tmp_path, capsys, edit, message):
+    f = tmp_path / "p.toml"
+    f.write_text(NONLINEAR.replace(*edit))
+    assert main(["solve", str(f), "--out", str(tmp_path / "run")]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()

@@ -369,7 +369,7 @@ def load_problem(path: str | Path) -> ProblemSpec:
         raise ProblemError(_where(sp_, f"[solver] {', '.join(sorted(path_keys))} only apply to type = \"nonlinear\""))
     ref = doc.get("reference", {})
     _check_keys(ref, {"value", "quantity", "tolerance", "source", "formula", "load_factors", "values", "curve",
-                      "curve_params", "compare"}, "reference", sp_)
+                      "curve_params", "compare", "abscissa", "abscissa_scale", "range_normalised"}, "reference", sp_)
     try:
         problem = Problem(shell, loads, supports, probes, n_collocation=ncol)
     except GraspdefError as exc:
