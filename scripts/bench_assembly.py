@@ -9,6 +9,9 @@ warm-up call (numba compilation / cache load):
 * ``ShellEnergy.energy``,
 * the KKT factorisation and solve of the Hessian with the six rigid modes fixed (``KKTSystem``).
 
+Also recorded: the median CPU time of the process (all threads) and the load average, since
+wall times on a shared machine depend on the other load.
+
 Target: 20 load steps of a squeezed sphere in <= 30 s, i.e. roughly <= 0.5 s per Hessian and
 <= 0.5 s per gradient + energy.  Writes ``bench_assembly.json`` to ``--out``.
 
@@ -27,13 +30,17 @@ from pathlib import Path
 import numpy as np
 
 
-def _median_time(fun, repeats: int) -> tuple[float, list[float]]:
-    ts = []
+def _median_time(fun, repeats: int) -> tuple[float, list[float], float]:
+    """Median wall time, all wall times, median CPU time of the process (all threads; less
+    sensitive than wall time to other load on a shared machine)."""
+    ts, cs = [], []
     for _ in range(repeats):
+        c = time.process_time()
         t = time.perf_counter()
         fun()
         ts.append(time.perf_counter() - t)
-    return statistics.median(ts), ts
+        cs.append(time.process_time() - c)
+    return statistics.median(ts), ts, statistics.median(cs)
 
 
 def main() -> None:
@@ -70,11 +77,12 @@ def main() -> None:
            "energy_value": float(e), "grad_norm": float(np.linalg.norm(g)), "hessian_nnz": int(H.nnz)}
     med = {}
     runs = {}
+    cpu = {}
     for name, fun in (("hessian", lambda: E.hessian(x)), ("gradient", lambda: E.gradient(x)),
                       ("energy", lambda: E.energy(x))):
-        med[name], runs[name] = _median_time(fun, a.repeats)
-        print(f"{name:9s} median {med[name]:.3f} s  runs {' '.join(f'{v:.3f}' for v in runs[name])}",
-              flush=True)
+        med[name], runs[name], cpu[name] = _median_time(fun, a.repeats)
+        print(f"{name:9s} median {med[name]:.3f} s (cpu {cpu[name]:.3f} s)  runs "
+              f"{' '.join(f'{v:.3f}' for v in runs[name])}", flush=True)
     if not a.no_kkt:
         from graspdef.problem.problem import Problem
         from graspdef.problem.supports import RigidModes
@@ -99,6 +107,8 @@ def main() -> None:
         print(f"kkt factor median {med['kkt_factor']:.3f} s  solve median {med['kkt_solve']:.3f} s "
               f"(backend {res['kkt_backend']}, n_negative {res['kkt_n_negative']})", flush=True)
     res["median_s"] = med
+    res["cpu_median_s"] = cpu
+    res["load_average"] = list(__import__("os").getloadavg())
     res["runs_s"] = runs
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)

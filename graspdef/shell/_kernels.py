@@ -301,18 +301,20 @@ def assemble_elements(y, w, dW, ddW, D, Dt, dstride, stencils, order, bstart, cb
     S = D.shape[2]
     S4 = Dt.shape[3]
     ncol = cstart.shape[0] - 1
+    u1, u2, u3, uS4 = np.uint64(1), np.uint64(2), np.uint64(3), np.uint64(S4)
     for col in range(ncol):
         for bi in nb.prange(cstart[col], cstart[col + 1]):
             blk_id = cblocks[bi]
             J = np.empty((6, 15))
-            CJ = np.empty((6, 15))
+            CJ = np.empty((6, 6))
+            Cw = np.empty((6, 6))
             Hy = np.empty((15, 15))
             Hyf = Hy.reshape(225)
             n = np.empty(3)
             sig = np.empty(6)
             gy = np.empty(15)
             ge = np.empty((S, 3))
-            T = np.empty((nq, S, 45))
+            Tf = np.empty(nq * S * 45)
             out = np.empty(S * 3 * 3 * S4)
             A1 = np.empty((3, 3))
             A2 = np.empty((3, 3))
@@ -342,27 +344,53 @@ def assemble_elements(y, w, dW, ddW, D, Dt, dstride, stencils, order, bstart, cb
                             ge[s, a] += acc
                     if not hess:
                         continue
+                    # material part J^T C J, C = w ddW, using the sparsity of J: columns 0..5 (a1, a2)
+                    # are dense, the curvature row 3 + k has fac_k n in the columns of a_(2+k) only
                     for i in range(6):
-                        for m in range(15):
+                        for l in range(6):
+                            Cw[i, l] = ddW[f, q, i, l] * wq
+                    for i in range(6):
+                        for m in range(6):
                             acc = 0.0
                             for l in range(6):
-                                acc += (ddW[f, q, i, l] * wq) * J[l, m]
+                                acc += Cw[i, l] * J[l, m]
                             CJ[i, m] = acc
-                    Hy[:, :] = 0.0
-                    for i in range(6):
-                        for m in range(15):
-                            jv = J[i, m]
-                            for mm in range(15):
-                                Hy[m, mm] += jv * CJ[i, mm]
+                    for m in range(6):
+                        for mm in range(6):
+                            acc = 0.0
+                            for i in range(6):
+                                acc += J[i, m] * CJ[i, mm]
+                            Hy[m, mm] = acc
+                        for k in range(3):
+                            acc = 0.0
+                            for i in range(6):
+                                acc += J[i, m] * Cw[i, 3 + k]
+                            fk = 2.0 if k == 2 else 1.0
+                            for a in range(3):
+                                v = acc * (fk * n[a])
+                                Hy[m, 6 + 3 * k + a] = v
+                                Hy[6 + 3 * k + a, m] = v
+                    for k in range(3):
+                        fk = 2.0 if k == 2 else 1.0
+                        for l in range(3):
+                            fl = 2.0 if l == 2 else 1.0
+                            ckl = Cw[3 + k, 3 + l] * (fk * fl)
+                            for a in range(3):
+                                for b in range(3):
+                                    Hy[6 + 3 * k + a, 6 + 3 * l + b] = ckl * (n[a] * n[b])
                     _point_geometric(y[f, q], sig, n, j, Hy, A1, A2, Hm, M, M2, PA)
-                    # T[q, s, (a, L, b)] = sum_K D[s, K] Hy[3K + a, 3L + b]
+                    # T[q, s, (a, L, b)] = sum_K D[s, K] Hy[3K + a, 3L + b]  (flat, unsigned indices:
+                    # no negative-index wraparound in the inner loops)
                     for s in range(S):
-                        Tq = T[q, s]
-                        Tq[:] = 0.0
+                        tq = np.uint64((q * S + s) * 45)
+                        for jj in range(45):
+                            Tf[tq + np.uint64(jj)] = 0.0
                         for K in range(5):
                             d = D[df, q, s, K]
+                            hk = np.uint64(45 * K)
                             for jj in range(45):
-                                Tq[jj] += d * Hyf[45 * K + jj]
+                                u = np.uint64(jj)
+                                Tf[tq + u] += d * Hyf[hk + u]
                 for s in range(S):
                     v = stencils[f, s]
                     for a in range(3):
@@ -370,10 +398,11 @@ def assemble_elements(y, w, dW, ddW, D, Dt, dstride, stencils, order, bstart, cb
                 if not hess:
                     continue
                 # out[s, a, b, t] = sum_q sum_L T[q, s, (a, L, b)] D[q, t, L] for t >= s, in
-                # register blocks of 3 (b) x 4 (t)
+                # register blocks of 3 (b) x 4 (t); flat arrays with unsigned indices
+                Dtf = Dt[df].reshape(nq * 5 * S4)
                 for s in range(S):
                     for a in range(3):
-                        r0 = (s * 3 + a) * 3 * S4
+                        r0 = np.uint64((s * 3 + a) * 3 * S4)
                         for t0 in range((s // 4) * 4, S4, 4):
                             c0 = 0.0
                             c1 = 0.0
@@ -389,14 +418,15 @@ def assemble_elements(y, w, dW, ddW, D, Dt, dstride, stencils, order, bstart, cb
                             e3 = 0.0
                             for q in range(nq):
                                 for L in range(5):
-                                    j0 = 15 * a + 3 * L
-                                    tv = T[q, s, j0]
-                                    uv = T[q, s, j0 + 1]
-                                    wv = T[q, s, j0 + 2]
-                                    x0 = Dt[df, q, L, t0]
-                                    x1 = Dt[df, q, L, t0 + 1]
-                                    x2 = Dt[df, q, L, t0 + 2]
-                                    x3 = Dt[df, q, L, t0 + 3]
+                                    jt = np.uint64((q * S + s) * 45 + 15 * a + 3 * L)
+                                    tv = Tf[jt]
+                                    uv = Tf[jt + u1]
+                                    wv = Tf[jt + u2]
+                                    kd = np.uint64((q * 5 + L) * S4 + t0)
+                                    x0 = Dtf[kd]
+                                    x1 = Dtf[kd + u1]
+                                    x2 = Dtf[kd + u2]
+                                    x3 = Dtf[kd + u3]
                                     c0 += tv * x0
                                     c1 += tv * x1
                                     c2 += tv * x2
@@ -409,37 +439,38 @@ def assemble_elements(y, w, dW, ddW, D, Dt, dstride, stencils, order, bstart, cb
                                     e1 += wv * x1
                                     e2 += wv * x2
                                     e3 += wv * x3
-                            o = r0 + t0
+                            o = r0 + np.uint64(t0)
                             out[o] = c0
-                            out[o + 1] = c1
-                            out[o + 2] = c2
-                            out[o + 3] = c3
-                            o += S4
+                            out[o + u1] = c1
+                            out[o + u2] = c2
+                            out[o + u3] = c3
+                            o += uS4
                             out[o] = d0
-                            out[o + 1] = d1
-                            out[o + 2] = d2
-                            out[o + 3] = d3
-                            o += S4
+                            out[o + u1] = d1
+                            out[o + u2] = d2
+                            out[o + u3] = d3
+                            o += uS4
                             out[o] = e0
-                            out[o + 1] = e1
-                            out[o + 2] = e2
-                            out[o + 3] = e3
+                            out[o + u1] = e1
+                            out[o + u2] = e2
+                            out[o + u3] = e3
                 base_f = f * S * S
                 for s in range(S):
                     # diagonal block symmetrised; off-diagonal block (s, t) and its transpose (t, s)
-                    p = 9 * index[base_f + s * S + s]
+                    pu = np.uint64(9 * index[base_f + s * S + s])
                     for a in range(3):
                         for b in range(3):
-                            bdata[p + 3 * a + b] += 0.5 * (out[((s * 3 + a) * 3 + b) * S4 + s]
-                                                           + out[((s * 3 + b) * 3 + a) * S4 + s])
+                            bdata[pu + np.uint64(3 * a + b)] += 0.5 * (
+                                out[np.uint64(((s * 3 + a) * 3 + b) * S4 + s)]
+                                + out[np.uint64(((s * 3 + b) * 3 + a) * S4 + s)])
                     for t in range(s + 1, S):
-                        p = 9 * index[base_f + s * S + t]
-                        pt = 9 * index[base_f + t * S + s]
+                        pu = np.uint64(9 * index[base_f + s * S + t])
+                        ptu = np.uint64(9 * index[base_f + t * S + s])
                         for a in range(3):
                             for b in range(3):
-                                v = out[((s * 3 + a) * 3 + b) * S4 + t]
-                                bdata[p + 3 * a + b] += v
-                                bdata[pt + 3 * b + a] += v
+                                v = out[np.uint64(((s * 3 + a) * 3 + b) * S4 + t)]
+                                bdata[pu + np.uint64(3 * a + b)] += v
+                                bdata[ptu + np.uint64(3 * b + a)] += v
 
 
 @nb.njit(cache=True, parallel=True)
