@@ -2,10 +2,10 @@
 
 Total potential energy of the control points x = X + u at load factor lam::
 
-    Pi(x, lam) = E(x) + 1/2 u.Kb.u - lam f.u + sum_i Pi_i(x, lam)
+    Pi(x, lam) = E(x) + Pi_N(x) - lam f.u + sum_i Pi_i(x, lam)
 
-with the shell's elastic energy E, the Nitsche rotation terms Kb of clamped/symmetry edges
-(constant: they act where rotations are held near zero), the dead loads f and the
+with the shell's elastic energy E, the Nitsche rotation terms Pi_N of clamped/symmetry edges
+(``graspdef.problem.nitsche``: consistent at finite deformation), the dead loads f and the
 configuration-dependent loads Pi_i (``graspdef.problem.potentials``).  Supports are the linear
 constraints C u = lam g (g non-zero for prescribed displacements); rigid-body modes of a free
 body are removed by a statically determinate 3-2-1 point support (exact at finite rotation).  The load direction is
@@ -24,6 +24,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import SolverError
+from ..problem.nitsche import NitscheRotation
 from ..problem.problem import Problem
 from ..shell.energy import ShellEnergy
 from .sparse import KKTSystem
@@ -38,7 +39,7 @@ class State:
     hessian: sp.csr_matrix | None
     rank_one: list
     load: np.ndarray
-    internal: np.ndarray | None = None      # elastic forces dE/dx + Kb u (the force scale)
+    internal: np.ndarray | None = None      # elastic forces dE/dx + dPi_N/dx (the force scale)
 
 
 class Equilibrium:
@@ -50,7 +51,7 @@ class Equilibrium:
         self.X = shell.rest_positions.copy()
         self.n = shell.n_dofs
         self.energy_fn = ShellEnergy(shell)
-        self.Kb = problem.boundary_stiffness().tocsr()
+        self.nitsche = NitscheRotation(shell, problem.supports, problem.evaluator)
         self.f = problem.dead_load_vector()
         self.potentials = problem.potentials()
         self.C, self.labels, self.g = problem.constraints(with_targets=True, rigid="three_point")
@@ -74,16 +75,20 @@ class Equilibrium:
             H = None
         else:
             E, grad, H = self.energy_fn.hessian(x)
-        E += 0.5 * float(u @ (self.Kb @ u)) - lam * float(self.f @ u) if self.Kb.nnz else -lam * float(self.f @ u)
+        if self.nitsche:
+            en, gn, Hn = self.nitsche.evaluate(x, order=max(order, 1))
+            E += en
+        E -= lam * float(self.f @ u)
         rank_one: list = []
         q = self.f.copy()
         internal = None
         if order >= 1:
-            grad = grad + (self.Kb @ u if self.Kb.nnz else 0.0)
+            if self.nitsche:
+                grad = grad + gn
             internal = grad
             grad = grad - lam * self.f
-            if order == 2 and self.Kb.nnz:
-                H = (H + self.Kb).tocsr()
+            if order == 2 and self.nitsche:
+                H = (H + Hn).tocsr()
         for pot in self.potentials:
             t = pot.evaluate(x, lam, order=max(order, 1))
             E += t.value
