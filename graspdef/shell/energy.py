@@ -240,7 +240,7 @@ class ShellEnergy:
         if self._to_csr is None:
             pos = (p.base[:, None, None] + np.arange(3)[:, None] * p.stride[:, None, None]
                    + np.arange(3)).ravel()                    # CSR position of (p, a, b)
-            inv = np.empty_like(pos)
+            inv = np.empty(len(pos), np.int32 if len(pos) < 2 ** 31 else np.int64)
             inv[pos] = np.arange(len(pos))
             self._to_csr = inv
         data = gather(bdata, self._to_csr)
