@@ -1,0 +1,315 @@
+"""Reading a run folder for the viewer (SI inside; the file's units kept for labels).
+
+Required: ``result.json``, ``deformed.ply`` and ``undeformed.ply`` (same vertex count and faces);
+for a nonlinear run also ``path.csv``.  Optional, used when present and skipped when absent:
+
+* ``problem.toml`` -- rebuilds the Problem for live re-solves and for the surface along the path;
+* ``path_u.npz`` -- control-point displacements of every path point (:mod:`.pathfile`);
+* ``contacts.json`` -- grasp contacts (see :func:`read_contacts` for the accepted layout);
+* ``score.json`` with ``scan_errors.ply`` -- a scan score (``graspdef score``), in the run folder
+  or in one of its sub-folders, or given explicitly.
+
+Every problem with a folder raises :class:`RunFolderError` naming the folder and the file.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import logging
+from dataclasses import dataclass, field
+from os import PathLike
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+import trimesh
+
+from ..errors import GraspdefError
+from ..geometry.io import LENGTH_UNITS
+from .pathfile import FILENAME as PATH_U_FILE
+from .pathfile import read_path_u
+
+log = logging.getLogger(__name__)
+
+MM = 1e3
+REQUIRED = ("result.json", "deformed.ply", "undeformed.ply")
+
+
+class RunFolderError(GraspdefError):
+    """A run folder is missing, incomplete or unreadable."""
+
+
+def unit_scale(unit: str | None) -> float:
+    """Metres per ``unit`` ("consistent" and unknown-but-stated consistent sets: 1)."""
+    if unit in (None, "consistent"):
+        return 1.0
+    if unit not in LENGTH_UNITS:
+        raise RunFolderError(f"unknown length unit {unit!r} (valid: {', '.join(LENGTH_UNITS)}, consistent)")
+    return LENGTH_UNITS[unit]
+
+
+def _ply(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, str | None]:
+    """Vertices (file units), faces (or (0, 3)), the raw vertex record array and the units comment."""
+    try:
+        m = trimesh.load(path, process=False)
+    except Exception as exc:  # trimesh raises many types for unreadable files
+        raise RunFolderError(f"{where}: cannot read {path.name}: {exc}") from None
+    verts = np.asarray(getattr(m, "vertices", np.zeros((0, 3))), dtype=np.float64)
+    faces = np.asarray(getattr(m, "faces", np.zeros((0, 3), int)), dtype=np.int64).reshape(-1, 3)
+    raw = (m.metadata.get("_ply_raw") or {}).get("vertex", {}).get("data") if hasattr(m, "metadata") else None
+    units = None
+    with path.open("rb") as fh:
+        head = fh.read(4096)
+    for line in head[: max(head.find(b"end_header"), 0)].splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[:2] == [b"comment", b"units"]:
+            units = parts[2].decode("ascii", "replace")
+    if verts.size == 0 or not np.all(np.isfinite(verts)):
+        raise RunFolderError(f"{where}: {path.name} has no vertices or non-finite ones")
+    return verts, faces, raw, units
+
+
+@dataclass
+class PathTable:
+    """``path.csv``: one row per converged point (probe displacements in SI)."""
+
+    load_factors: np.ndarray                     # (k,)
+    probes: dict[str, np.ndarray]                # name -> (k, 3) [m]
+    stable: list                                 # (k,) True/False/None
+    columns: dict[str, np.ndarray]               # every numeric column by header name
+
+
+@dataclass
+class Contacts:
+    """Grasp contacts in SI: fingers (dicts with name, position [m], wxyz, size [m] or None) and
+    contact points (c, 3) [m] with their forces (c, 3) [N] on the object."""
+
+    fingers: list[dict]
+    points: np.ndarray
+    forces: np.ndarray
+    force_unit: str = "N"
+
+
+@dataclass
+class ScanOverlay:
+    """A scan in the prediction's frame [m] with its signed per-point error [mm]."""
+
+    points: np.ndarray          # (s, 3) [m]
+    errors_mm: np.ndarray       # (s,)
+    stats_mm: dict
+    baseline_stats_mm: dict
+    summary: str
+    source: Path
+
+
+@dataclass
+class RunData:
+    """One run folder, read (see the module docstring)."""
+
+    path: Path
+    name: str
+    record: dict
+    analysis: str
+    length_unit: str
+    force_unit: str
+    length_scale: float                            # metres per file length unit
+    faces: np.ndarray                              # (m, 3)
+    rest_vertices: np.ndarray                      # (n, 3) [m] limit surface at rest
+    deformed_vertices: np.ndarray                  # (n, 3) [m] final state
+    problem_file: Path | None = None
+    path_table: PathTable | None = None
+    path_u: tuple[np.ndarray, np.ndarray, sp.csr_matrix] | None = None
+    contacts: Contacts | None = None
+    scan: ScanOverlay | None = None
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def displacements(self) -> np.ndarray:
+        """Final limit displacements (n, 3) [m]."""
+        return self.deformed_vertices - self.rest_vertices
+
+    @property
+    def label(self) -> str:
+        return f"{self.name} ({self.analysis})"
+
+    def path_displacements(self, i: int) -> np.ndarray | None:
+        """Limit displacements (n, 3) [m] of path point ``i`` (None without path_u)."""
+        if self.path_u is None:
+            return None
+        u, _, L = self.path_u
+        return L @ u[i]
+
+
+def read_path_csv(path: Path, length_scale: float, where: str) -> PathTable:
+    try:
+        with path.open(newline="") as fh:
+            rows = list(csv.reader(fh))
+    except OSError as exc:
+        raise RunFolderError(f"{where}: cannot read path.csv: {exc}") from None
+    if len(rows) < 2 or "load_factor" not in rows[0]:
+        raise RunFolderError(f"{where}: path.csv has no 'load_factor' column or no rows (incomplete run?)")
+    header, body = rows[0], rows[1:]
+    cols: dict[str, np.ndarray] = {}
+    for j, name in enumerate(header):
+        try:
+            cols[name] = np.array([float(r[j]) if r[j] != "" else np.nan for r in body])
+        except (ValueError, IndexError):
+            continue
+    probes: dict[str, np.ndarray] = {}
+    for name in header:
+        if "_ux[" in name:
+            base, unit = name.split("_ux[")
+            comps = [cols.get(f"{base}_u{c}[{unit}") for c in "xyz"]
+            if all(c is not None for c in comps):
+                probes[base] = np.stack(comps, axis=1) * length_scale
+    stable = [None if not np.isfinite(v) else bool(v) for v in cols.get("stable", np.full(len(body), np.nan))]
+    return PathTable(cols["load_factor"], probes, stable, cols)
+
+
+def _vec(v, n: int, what: str, where: str) -> np.ndarray:
+    a = np.asarray(v, dtype=float)
+    if a.shape != (n,) or not np.all(np.isfinite(a)):
+        raise RunFolderError(f"{where}: contacts.json: {what} must be {n} finite numbers, got {v!r}")
+    return a
+
+
+def read_contacts(path: Path, default_length_unit: str, where: str) -> Contacts:
+    """Read ``contacts.json``.
+
+    Accepted layout (lengths in ``units.length``, default the run's; forces in ``units.force``,
+    default N; forces act on the object)::
+
+        {"units": {"length": "mm", "force": "N"},
+         "fingers": [{"name": "left_pad", "position": [x, y, z],
+                      "wxyz": [1, 0, 0, 0], "size": [sx, sy, sz]}, ...],
+         "contacts": [{"position": [x, y, z], "force": [fx, fy, fz], "finger": "left_pad"}, ...]}
+
+    ``point``/``at`` are accepted for ``position``, ``quaternion`` for ``wxyz``."""
+    try:
+        doc = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise RunFolderError(f"{where}: contacts.json is not valid JSON: {exc}") from None
+    if not isinstance(doc, dict):
+        raise RunFolderError(f"{where}: contacts.json must hold an object")
+    units = doc.get("units", {}) if isinstance(doc.get("units", {}), dict) else {}
+    ls = unit_scale(units.get("length", default_length_unit))
+    fu = units.get("force", "N")
+    fs = {"N": 1.0, "kN": 1e3, "mN": 1e-3, "consistent": 1.0}.get(fu)
+    if fs is None:
+        raise RunFolderError(f"{where}: contacts.json: unknown force unit {fu!r}")
+    fingers = []
+    for i, f in enumerate(doc.get("fingers", []) or []):
+        if not isinstance(f, dict):
+            raise RunFolderError(f"{where}: contacts.json: fingers[{i}] must be an object")
+        pos = f.get("position", f.get("pos"))
+        q = f.get("wxyz", f.get("quaternion", [1.0, 0.0, 0.0, 0.0]))
+        size = f.get("size")
+        fingers.append({"name": str(f.get("name", f"finger_{i}")),
+                        "position": _vec(pos, 3, f"fingers[{i}].position", where) * ls,
+                        "wxyz": _vec(q, 4, f"fingers[{i}].wxyz", where),
+                        "size": None if size is None else np.abs(_vec(size, 3, f"fingers[{i}].size", where)) * ls})
+    pts, frc = [], []
+    for i, c in enumerate(doc.get("contacts", []) or []):
+        if not isinstance(c, dict):
+            raise RunFolderError(f"{where}: contacts.json: contacts[{i}] must be an object")
+        p = c.get("position", c.get("point", c.get("at")))
+        pts.append(_vec(p, 3, f"contacts[{i}].position", where) * ls)
+        frc.append(_vec(c.get("force"), 3, f"contacts[{i}].force", where) * fs)
+    return Contacts(fingers, np.array(pts).reshape(-1, 3), np.array(frc).reshape(-1, 3), "N")
+
+
+def find_score(run_dir: Path) -> Path | None:
+    """The folder holding a ``score.json`` for this run: the run folder or one sub-folder."""
+    if (run_dir / "score.json").is_file():
+        return run_dir
+    subs = sorted(p.parent for p in run_dir.glob("*/score.json"))
+    return subs[0] if subs else None
+
+
+def read_scan_overlay(score_dir: Path, where: str) -> ScanOverlay:
+    """A ``graspdef score`` folder: the scan (``scan_errors.ply``) moved into the prediction's
+    frame with the stored registration, and its signed errors [mm]."""
+    try:
+        rec = json.loads((score_dir / "score.json").read_text())
+    except (OSError, ValueError) as exc:
+        raise RunFolderError(f"{where}: cannot read {score_dir / 'score.json'}: {exc}") from None
+    name = (rec.get("files") or {}).get("scan_errors", "scan_errors.ply")
+    f = score_dir / name
+    if not f.is_file():
+        raise RunFolderError(f"{where}: score.json names {name}, which is missing in {score_dir}")
+    verts, _, raw, units = _ply(f, where)
+    if raw is None or "error_mm" not in raw.dtype.names:
+        raise RunFolderError(f"{where}: {name} has no per-point 'error_mm'")
+    s_units = units or (rec.get("inputs") or {}).get("scan_units")
+    pts = verts * unit_scale(s_units)
+    try:
+        T = np.asarray(rec["prediction"]["registration"]["transform_scan_to_surface"], float)
+    except (KeyError, TypeError):
+        T = np.eye(4)
+    if T.shape != (4, 4):
+        raise RunFolderError(f"{where}: score.json: transform_scan_to_surface must be 4x4")
+    pts = pts @ T[:3, :3].T + T[:3, 3] / MM                   # "t in mm"
+    pred = (rec.get("prediction") or {}).get("errors", {})
+    base = (rec.get("baseline") or {}).get("errors", {})
+    return ScanOverlay(pts, np.asarray(raw["error_mm"], float), pred, base, str(rec.get("summary", "")), score_dir)
+
+
+def read_run(run_dir: str | PathLike, score_dir: str | PathLike | None = None) -> RunData:
+    """Read a run folder (see the module docstring); raise :class:`RunFolderError` if it is
+    missing, incomplete or inconsistent."""
+    d = Path(run_dir)
+    where = f"run folder {d}"
+    if not d.exists():
+        raise RunFolderError(f"{where} does not exist")
+    if not d.is_dir():
+        raise RunFolderError(f"{where} is not a folder")
+    missing = [f for f in REQUIRED if not (d / f).is_file()]
+    if missing:
+        raise RunFolderError(f"{where} is incomplete: missing {', '.join(missing)} (write one with "
+                             "'graspdef solve PROBLEM.toml --out DIR')")
+    try:
+        rec = json.loads((d / "result.json").read_text())
+    except ValueError as exc:
+        raise RunFolderError(f"{where}: result.json is not valid JSON: {exc}") from None
+    if not isinstance(rec, dict) or "units" not in rec:
+        raise RunFolderError(f"{where}: result.json has no 'units' (not a graspdef result)")
+    lu = rec["units"].get("length", "consistent")
+    fu = rec["units"].get("force", "consistent")
+    ls = unit_scale(lu)
+    dv, df, _, du = _ply(d / "deformed.ply", where)
+    rv, rf, _, ru = _ply(d / "undeformed.ply", where)
+    for fname, u in (("deformed.ply", du), ("undeformed.ply", ru)):
+        if u is not None and u != lu:
+            raise RunFolderError(f"{where}: {fname} states units {u!r} but result.json says {lu!r}")
+    if dv.shape != rv.shape or df.shape != rf.shape or not np.array_equal(df, rf):
+        raise RunFolderError(f"{where}: deformed.ply ({len(dv)} vertices, {len(df)} faces) and undeformed.ply "
+                             f"({len(rv)} vertices, {len(rf)} faces) do not match")
+    if len(df) == 0:
+        raise RunFolderError(f"{where}: deformed.ply has no faces")
+    analysis = str(rec.get("analysis", "linear"))
+    run = RunData(d, str(rec.get("name", d.name)), rec, analysis, lu, fu, ls, df, rv * ls, dv * ls)
+    if (d / "problem.toml").is_file():
+        run.problem_file = d / "problem.toml"
+    else:
+        run.notes.append("no problem.toml: live re-solves are off")
+    if analysis == "nonlinear":
+        if not (d / "path.csv").is_file():
+            raise RunFolderError(f"{where} is incomplete: a nonlinear run needs path.csv")
+        run.path_table = read_path_csv(d / "path.csv", ls, where)
+        if (d / PATH_U_FILE).is_file():
+            try:
+                u, lf, L = read_path_u(d / PATH_U_FILE)
+            except (ValueError, OSError, KeyError) as exc:
+                raise RunFolderError(f"{where}: {PATH_U_FILE}: {exc}") from None
+            if L.shape[0] != len(rv) or len(lf) != len(run.path_table.load_factors) or \
+                    not np.allclose(lf, run.path_table.load_factors, rtol=1e-9, atol=1e-12):
+                raise RunFolderError(f"{where}: {PATH_U_FILE} does not match path.csv / the surface")
+            run.path_u = (u, lf, L)
+    if (d / "contacts.json").is_file():
+        run.contacts = read_contacts(d / "contacts.json", lu, where)
+    sd = Path(score_dir) if score_dir is not None else find_score(d)
+    if score_dir is not None and not (sd / "score.json").is_file():
+        raise RunFolderError(f"score folder {sd}: no score.json")
+    if sd is not None:
+        run.scan = read_scan_overlay(sd, where)
+    return run

@@ -1,0 +1,155 @@
+"""Small run folders written through the real solve path (linear plate in mm/N, nonlinear
+cantilever with and without path_u.npz), plus synthetic contacts.json and score folders."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+PLATE_MM = """
+name = "plate_mm"
+[units]
+length = "mm"
+force = "N"
+[geometry]
+type = "rectangle"
+lx = 100.0
+ly = 100.0
+nx = 10
+ny = 10
+[material]
+E = 2000.0          # N/mm^2 = 2 GPa
+nu = 0.3
+[shell]
+thickness = 1.0
+[regions]
+edges = "abs(abs(x) - 50) < 1e-6 or abs(abs(y) - 50) < 1e-6"
+[[supports]]
+kind = "simply_supported"
+region = "edges"
+[[loads]]
+kind = "point"
+at = [0.0, 0.0, 0.0]
+force = [0.0, 0.0, -2.0]
+[[probes]]
+name = "centre"
+at = [0.0, 0.0, 0.0]
+"""
+
+CANTILEVER = """
+name = "cantilever_small"
+[units]
+length = "consistent"
+force = "consistent"
+[geometry]
+type = "rectangle"
+lx = 10.0
+ly = 1.0
+nx = 10
+ny = 2
+center = [5.0, 0.5]
+[material]
+model = "saint_venant_kirchhoff"
+E = 1.2e6
+nu = 0.0
+[shell]
+thickness = 0.1
+[regions]
+root = "abs(x) < 1e-9"
+tip = "abs(x - 10) < 1e-9"
+[[supports]]
+kind = "clamped"
+region = "root"
+[[loads]]
+kind = "edge_load"
+region = "tip"
+force = [0.0, 0.0, 1.0]
+[[probes]]
+name = "tip"
+at = [10.0, 0.5, 0.0]
+[solver]
+type = "nonlinear"
+method = "load"
+steps = 4
+"""
+
+
+def _solve(folder: Path, text: str, path_u: bool = True) -> Path:
+    from graspdef.problem.config import load_problem
+    from graspdef.solve.output import write_run
+    from graspdef.viewer import write_solution_path
+
+    src = folder.parent / f"{folder.name}.toml"
+    src.write_text(text)
+    spec = load_problem(src)
+    if spec.solver.get("type") == "nonlinear":
+        from graspdef.solve.nonlinear import path_options, solve_nonlinear
+
+        sol = solve_nonlinear(spec.problem, path_options(spec.solver))
+    else:
+        from graspdef.solve.linear import solve_linear
+
+        sol = solve_linear(spec.problem)
+    write_run(folder, spec, sol, text)
+    if path_u and spec.solver.get("type") == "nonlinear":
+        write_solution_path(folder, sol)
+    return folder
+
+
+@pytest.fixture(scope="session")
+def run_root(tmp_path_factory) -> Path:
+    return tmp_path_factory.mktemp("viewer_runs")
+
+
+@pytest.fixture(scope="session")
+def plate_run(run_root) -> Path:
+    """Linear plate in mm and N, with a synthetic grasp (contacts.json) and scan score."""
+    d = _solve(run_root / "plate", PLATE_MM)
+    write_synthetic_contacts(d)
+    write_synthetic_score(d / "score")
+    return d
+
+
+@pytest.fixture(scope="session")
+def cantilever_run(run_root) -> Path:
+    return _solve(run_root / "cantilever", CANTILEVER)
+
+
+@pytest.fixture(scope="session")
+def cantilever_run_no_path(run_root) -> Path:
+    return _solve(run_root / "cantilever_nopath", CANTILEVER, path_u=False)
+
+
+def write_synthetic_contacts(d: Path) -> None:
+    """Two fingers pinching the plate centre (mm, N): the layout graspdef.viewer.runs accepts."""
+    doc = {"units": {"length": "mm", "force": "N"},
+           "fingers": [{"name": "top_pad", "position": [0, 0, 6], "wxyz": [1, 0, 0, 0], "size": [8, 8, 10]},
+                       {"name": "bottom_pad", "position": [0, 0, -6], "size": [8, 8, 10]}],
+           "contacts": [{"position": [0, 0, 0.5], "force": [0, 0, -2.0], "finger": "top_pad"},
+                        {"position": [0, 0, -0.5], "force": [0, 0, 1.0], "finger": "bottom_pad"}]}
+    (d / "contacts.json").write_text(json.dumps(doc))
+
+
+def write_synthetic_score(d: Path) -> None:
+    """A score folder as graspdef score writes it: a scan (mm) 10 mm above the plate in its own
+    frame, registered by a translation of -10 mm in z, errors growing with x."""
+    from graspdef.geometry.io import save_ply
+
+    d.mkdir(parents=True, exist_ok=True)
+    g = np.linspace(-45, 45, 10)
+    x, y = np.meshgrid(g, g)
+    pts = np.c_[x.ravel(), y.ravel(), np.full(x.size, 10.0)] * 1e-3          # [m]
+    err = x.ravel() / 45.0 * 0.5                                             # [mm]
+    save_ply(d / "scan_errors.ply", pts, np.zeros((0, 3), int), units="mm",
+             vertex_scalars={"error_mm": err, "baseline_error_mm": 2 * err})
+    T = np.eye(4)
+    T[2, 3] = -10.0                                                          # t in mm
+    rec = {"units": {"length": "mm"}, "inputs": {"scan_units": "mm"},
+           "prediction": {"errors": {"mean_mm": 0.25, "rms_mm": 0.29, "max_mm": 0.5},
+                          "registration": {"transform_scan_to_surface": T.tolist()}},
+           "baseline": {"errors": {"mean_mm": 0.5, "rms_mm": 0.58, "max_mm": 1.0}},
+           "summary": "synthetic score", "flags": [], "ok": True,
+           "files": {"scan_errors": "scan_errors.ply"}}
+    (d / "score.json").write_text(json.dumps(rec))
