@@ -6,7 +6,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: setup demo test clean system-packages
+.PHONY: setup demo test test-slow clean system-packages
 
 # Debian packages the Python dependencies need at run time (installed when run as root).
 DEB_PACKAGES := libgomp1 libusb-1.0-0
@@ -31,6 +31,9 @@ demo: setup
 
 test: setup
 	$(PY) -m pytest -q -m "not slow"
+
+test-slow: setup
+	$(PY) -m pytest -q -m slow
 
 clean:
 	rm -rf $(VENV) out .pytest_cache
