@@ -1,0 +1,336 @@
+"""``graspdef grasp SCENE --force F [--contact point] [--analysis nonlinear] --out DIR``.
+
+The chain (issue 5):
+
+1. read the scene's ``shell.toml`` (object body, scan, thickness, material, gas, supports) and
+   build the shell: control mesh of the scan (graspdef.scans.control_mesh), offset inward by
+   t/2 (mid_surface);
+2. MuJoCo: close the gripper until each finger presses with the target force, settle, extract
+   the contacts and the object's pose (graspdef.sim.grasp);
+3. contacts -> object frame -> point loads on the limit surface keeping total force and moment
+   (graspdef.contact.map_contacts); the object's weight enters as a body force, so the loads
+   balance to MuJoCo's settling accuracy; the residual net force and moment are reported;
+4. a free object is held only by the fingers: its rigid-body modes are removed by
+   RigidModes (a statically determinate 3-2-1 support in nonlinear solves, whose reactions
+   are the residual); a fixed object (the duck-head poke) by point supports from shell.toml;
+5. linear or nonlinear solve; the indentation (approach of the contact points) is fed back:
+   predicted finger gap = rigid-proxy gap - approach, mismatch against MuJoCo's gap reported;
+6. the run folder, written atomically: result.json, contacts.json, deformed.ply,
+   undeformed.ply (limit surface, metres), path.csv (nonlinear).
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import logging
+import shutil
+import tempfile
+import time
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..contact.mapping import map_contacts
+from ..errors import GraspdefError, ProblemError
+from ..geometry.io import save_ply
+from ..problem.loads import BodyForce
+from ..problem.potentials import EnclosedGas
+from ..problem.problem import Problem
+from ..problem.supports import PointSupport, RigidModes
+from ..scans import control_mesh, load_scan, mid_surface
+from ..shell.hyperelastic import NeoHookean
+from ..shell.materials import LinearElastic
+from ..shell.model import Shell
+from ..sim.grasp import GraspSettings, grasp
+from ..solve.linear import solve_linear
+from ..solve.nonlinear import PathOptions, PathStopped, solve_nonlinear
+
+log = logging.getLogger(__name__)
+SCENES = Path(__file__).resolve().parents[2] / "scenes"
+
+
+@dataclass(frozen=True)
+class ShellSpec:
+    """A scene's shell.toml, in SI."""
+
+    folder: Path
+    body: str
+    scan: str
+    scene: str
+    thickness: float
+    E: float
+    nu: float
+    control_faces: int
+    remesh: str
+    gas_p0: float
+    fingers: tuple[str, ...]
+    fixed_points: tuple[tuple[float, float, float], ...]
+    steps: int
+    raw: dict = field(default_factory=dict)
+
+    def material(self, analysis: str):
+        if analysis == "linear":
+            return LinearElastic(self.E, self.nu)
+        if abs(self.nu - 0.5) > 1e-9:
+            log.info("neo-Hookean shells are incompressible (nu = 0.5); E = %g Pa gives mu = E/3", self.E)
+        return NeoHookean(self.E / 3.0)
+
+
+def resolve_scene(scene: str | Path) -> Path:
+    """A scene folder, its scene*.xml, or a name under scenes/ -> the scene XML path."""
+    p = Path(scene)
+    if p.is_dir():
+        p = p / "scene.xml"
+    elif not p.exists() and (SCENES / str(scene)).is_dir():
+        p = SCENES / str(scene) / "scene.xml"
+    if not p.is_file():
+        raise ProblemError(f"scene not found: {scene} (give a scene.xml, its folder, or a name in {SCENES})")
+    return p
+
+
+def load_shell_spec(scene_xml: Path) -> ShellSpec:
+    f = scene_xml.parent / "shell.toml"
+    if not f.is_file():
+        raise ProblemError(f"{scene_xml.parent}: no shell.toml beside the scene (the object's shell model)")
+    try:
+        t = tomllib.loads(f.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ProblemError(f"{f}: {exc}") from exc
+    try:
+        o, s, m = t["object"], t["shell"], t["material"]
+        return ShellSpec(scene_xml.parent, o["body"], o["scan"], scene_xml.name, float(s["thickness_mm"]) * 1e-3,
+                         float(m["E_MPa"]) * 1e6, float(m["nu"]), int(s.get("control_faces", 1280)),
+                         s.get("remesh", "auto"), float(t.get("gas", {}).get("p0_kPa", 0.0)) * 1e3,
+                         tuple(t.get("grasp", {}).get("fingers", ["left", "right"])),
+                         tuple(tuple(float(v) * 1e-3 for v in p) for p in t.get("supports", {}).get("fixed_points_mm", [])),
+                         int(t.get("solver", {}).get("steps", 8)), t)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ProblemError(f"{f}: missing or bad entry {exc}") from exc
+
+
+def build_shell(spec: ShellSpec, analysis: str) -> tuple[Shell, dict]:
+    scan = load_scan(spec.scan)
+    outer, rep = control_mesh(scan, spec.control_faces, spec.remesh)
+    mid = mid_surface(outer, spec.thickness)
+    return Shell(mid.vertices, mid.faces, spec.material(analysis), spec.thickness), {
+        "scan": spec.scan, "control_faces": int(len(mid.faces)), "control_vertices": int(len(mid.vertices)),
+        "remesh": getattr(rep, "method", spec.remesh)}
+
+
+@dataclass
+class GraspRun:
+    out: Path
+    result: dict
+
+
+def _rigid_fit_residual(x: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """u minus its least-squares infinitesimal rigid motion (translation + rotation about the
+    centroid): the deformation part."""
+    c = x.mean(axis=0)
+    r = x - c
+    A = np.zeros((3 * len(x), 6))
+    A[:, :3] = np.tile(np.eye(3), (len(x), 1))
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = 1
+        A[:, 3 + k] = np.cross(e, r).ravel()
+    coef = np.linalg.lstsq(A, u.ravel(), rcond=None)[0]
+    return u - (A @ coef).reshape(-1, 3)
+
+
+def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonlinear", out=None,
+              gas: bool | None = None, settings: GraspSettings = GraspSettings(), control_faces: int | None = None,
+              steps: int | None = None) -> GraspRun:
+    """Run the whole chain for ``scene`` at ``force`` [N] per finger; write the run folder ``out``
+    (when given) and return its result record.
+
+    ``gas``: None = as shell.toml says; False/True forces the enclosed air off/on."""
+    t0 = time.perf_counter()
+    if contact != "point":
+        raise ProblemError(f"contact model {contact!r} is not implemented (only 'point': the paper's point loads)")
+    if analysis not in ("linear", "nonlinear"):
+        raise ProblemError(f"analysis must be 'linear' or 'nonlinear', got {analysis!r}")
+    if not np.isfinite(force) or force <= 0:
+        raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
+    xml = resolve_scene(scene)
+    spec = load_shell_spec(xml)
+    if control_faces:
+        spec = ShellSpec(**{**spec.__dict__, "control_faces": int(control_faces)})
+    p0 = spec.gas_p0 if gas is None else (spec.gas_p0 if gas else 0.0)
+    if gas and p0 <= 0:
+        p0 = 80e3
+    t_setup = time.perf_counter()
+    shell, shell_info = build_shell(spec, analysis)
+    t_shell = time.perf_counter()
+    targets = {s: (force if s in spec.fingers else 0.0) for s in ("left", "right")}
+    g = grasp(xml, targets, spec.body, settings)
+    t_sim = time.perf_counter()
+    cs = g.contacts.transformed(g.pose)
+    mapping = map_contacts(shell, cs)
+    loads = list(mapping.loads)
+    g_obj = g.pose.vector_to_object(g.gravity)
+    free = bool(g.info.get("free_object", True))
+    area = float(shell.mesh_area()) if hasattr(shell, "mesh_area") else None
+    if area is None:
+        v, f = shell.mesh.vertices, shell.mesh.faces[: shell.mesh.n_real_faces]
+        area = float(0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1).sum())
+    if free:
+        loads.append(BodyForce(g.object_mass / (spec.thickness * area), tuple(g_obj)))
+        supports = [RigidModes()]
+    else:
+        supports = []
+        pr0 = Problem(shell, [], [RigidModes()])
+        for i, p in enumerate(spec.fixed_points):
+            sp = pr0.locate(p, f"fixed point {i}", tol=5e-3)
+            supports.append(PointSupport(sp.face, sp.bary, name=f"fixed_{i}"))
+        if not supports:
+            raise ProblemError(f"{spec.folder}/shell.toml: a fixed object needs [supports] fixed_points_mm")
+    if p0 > 0:
+        loads.append(EnclosedGas(p0))
+    probes = {}
+    for s in sorted(set(mapping.finger)):
+        idx = [i for i, f in enumerate(mapping.finger) if f == s]
+        k = idx[int(np.argmax([np.linalg.norm(mapping.forces[i]) for i in idx]))]
+        probes[s] = mapping.surface_points[k]
+    problem = Problem(shell, loads, supports, probes)
+    residual_F = mapping.force_out + (g.object_mass * g_obj if free else 0.0)
+    residual_M = mapping.moment_out + (np.cross(shell.rest_positions[: shell.mesh.n_real].mean(axis=0),
+                                                g.object_mass * g_obj) if free else 0.0)
+    completed, stop_reason = True, None
+    if analysis == "linear":
+        if p0 > 0:
+            raise ProblemError("an enclosed gas needs the nonlinear analysis (p V = const is nonlinear)")
+        sol = solve_linear(problem)
+    else:
+        opt = PathOptions(steps=steps or spec.steps, max_steps=40 * (steps or spec.steps), min_step=1e-3)
+        try:
+            sol = solve_nonlinear(problem, opt)
+        except PathStopped as exc:
+            sol, completed, stop_reason = exc.solution, False, str(exc)
+    t_solve = time.perf_counter()
+    # displacements and indentation (rigid-motion free)
+    Lm = sol.limit_map()
+    x_lim = Lm @ shell.mesh.vertices
+    u_lim = sol.vertex_displacements()
+    u_def = _rigid_fit_residual(x_lim, u_lim) if free else u_lim
+    fingers = {}
+    pf = g.per_finger()
+    for s, sp in probes.items():
+        u = sol.probe(s)
+        n = pf[s]["normal"]
+        fingers[s] = {"target_N": targets[s], "normal_force_N": pf[s]["normal_force"],
+                      "axial_force_N": g.info["axial_force_N"][s],
+                      "friction_force_N": pf[s]["friction_force"], "n_contacts": pf[s]["n_contacts"],
+                      "load_point_m": mapping.points[[i for i, f in enumerate(mapping.finger) if f == s][0]].tolist(),
+                      "displacement_m": u.tolist(), "displacement_along_normal_m": float(u @ g.pose.vector_to_object(n))}
+    feedback = {}
+    if len(probes) == 2:
+        e = g.pose.vector_to_object(pf["right"]["point"] - pf["left"]["point"])
+        sep = float(np.linalg.norm(e))
+        e /= sep
+        approach = float((sol.probe("left") - sol.probe("right")) @ e)
+        feedback = {"rigid_contact_separation_m": sep, "approach_m": approach,
+                    "indentation_per_finger_m": approach / 2,
+                    "mujoco_tip_gap_m": g.tip_gap, "predicted_tip_gap_m": g.tip_gap - approach,
+                    "mismatch_m": approach,
+                    "note": "one-way coupling: MuJoCo's rigid proxy keeps the fingers at the undeformed gap "
+                            "(less its soft-contact penetration); the shell says they close by 'approach'"}
+    else:
+        s = next(iter(probes))
+        ind = -fingers[s]["displacement_along_normal_m"]
+        feedback = {"indentation_m": ind, "mujoco_tip_gap_m": g.tip_gap, "mismatch_m": ind}
+    rec = {
+        "scene": str(xml), "object": spec.body, "force_N": force, "contact": contact, "analysis": analysis,
+        "material": {"model": "linear_elastic" if analysis == "linear" else "neo_hookean", "E_Pa": spec.E,
+                     "nu": spec.nu if analysis == "linear" else 0.5, "thickness_m": spec.thickness},
+        "gas_p0_Pa": p0, "shell": shell_info,
+        "max_displacement_m": float(np.linalg.norm(u_def, axis=1).max()),
+        "max_displacement_raw_m": float(np.linalg.norm(u_lim, axis=1).max()),
+        "fingers": fingers, "feedback": feedback,
+        "contact_area_m2": 0.0,
+        "load_mapping": mapping.record(),
+        "residual": {"net_force_N": np.asarray(residual_F).tolist(), "net_moment_Nm": np.asarray(residual_M).tolist()},
+        "mujoco": g.record(),
+        "convergence": {"completed": completed, "stop_reason": stop_reason},
+        "timings_s": {"shell_setup": t_shell - t_setup, "mujoco": t_sim - t_shell, "solve": t_solve - t_sim,
+                      "total": time.perf_counter() - t0},
+        "units": "SI (m, N, Pa)",
+    }
+    if analysis == "nonlinear":
+        rec["convergence"].update({"load_factor": sol.load_factor, "n_points": len(sol.path),
+                                   "newton_iterations": sol.iterations(), "n_factorisations": sol.n_factorisations,
+                                   "critical_points": [dict(cp, probes={k: np.asarray(v).tolist() for k, v in cp["probes"].items()})
+                                                       for cp in sol.critical_points]})
+    else:
+        rec["convergence"].update({"relative_residual": sol.kkt.residual})
+    if out is not None:
+        out = Path(out)
+        _write(out, rec, g, sol, x_lim, u_def)
+    return GraspRun(Path(out) if out is not None else None, rec)
+
+
+def _write(out: Path, rec: dict, g, sol, x_lim, u_def) -> None:
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    try:
+        rec = dict(rec, files={"deformed": "deformed.ply", "undeformed": "undeformed.ply", "contacts": "contacts.json"})
+        (tmp / "result.json").write_text(json.dumps(rec, indent=2, default=float) + "\n")
+        (tmp / "contacts.json").write_text(json.dumps({
+            "frame": "world", "object_pose": g.pose.record(), "contacts": g.contacts.records(),
+            "per_finger": rec["mujoco"]["per_finger"]}, indent=2) + "\n")
+        verts, faces = sol.deformed_surface()
+        save_ply(tmp / "deformed.ply", verts, faces, units="m",
+                 vertex_scalars={"displacement": np.linalg.norm(u_def, axis=1)})
+        save_ply(tmp / "undeformed.ply", x_lim, faces, units="m")
+        if hasattr(sol, "path"):
+            with open(tmp / "path.csv", "w", newline="") as fh:
+                w = csv.writer(fh)
+                names = list(sol.problem.probes)
+                w.writerow(["point", "load_factor", "newton_iterations"] + [f"{n}_u{c}[m]" for n in names for c in "xyz"])
+                for i, p in enumerate(sol.path):
+                    w.writerow([i, p.load_factor, p.iterations] + [float(v) for n in names for v in p.probes[n]])
+        if out.exists():
+            shutil.rmtree(out)
+        tmp.rename(out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def grasp_cli(argv: list[str] | None = None) -> int:
+    """``graspdef grasp SCENE --force F [--contact point|geometric] [--analysis ...] --out DIR``."""
+    ap = argparse.ArgumentParser(prog="graspdef grasp", description="MuJoCo grasp -> shell deformation run folder")
+    add_arguments(ap)
+    a = ap.parse_args(argv)
+    return run_from_args(a)
+
+
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    ap.add_argument("scene", help="scene.xml, its folder, or a name under scenes/ (e.g. tennis_ball)")
+    ap.add_argument("--force", type=float, required=True, help="squeezing force per finger [N]")
+    ap.add_argument("--contact", choices=["point", "geometric"], default="point")
+    ap.add_argument("--analysis", choices=["linear", "nonlinear"], default="nonlinear")
+    ap.add_argument("--gas", choices=["auto", "on", "off"], default="auto", help="enclosed air (shell.toml's p0)")
+    ap.add_argument("--out", required=True, help="run folder to write")
+
+
+def run_from_args(a) -> int:
+    import sys
+
+    gas = {"auto": None, "on": True, "off": False}[a.gas]
+    try:
+        run = run_grasp(a.scene, a.force, a.contact, a.analysis, a.out, gas=gas)
+    except GraspdefError as exc:
+        print(f"graspdef: error: {exc}", file=sys.stderr)
+        return 2
+    r = run.result
+    fb = r["feedback"]
+    print(f"{r['object']}: {r['analysis']} {r['contact']}-load shell at {r['force_N']:g} N per finger: max displacement "
+          f"{r['max_displacement_m'] * 1e3:.3f} mm; indentation {1e3 * fb.get('indentation_per_finger_m', fb.get('indentation_m', 0)):.3f} mm"
+          f"{'' if r['convergence']['completed'] else ' (path stopped: ' + str(r['convergence']['stop_reason']) + ')'}; "
+          f"{r['timings_s']['total']:.1f} s")
+    print(f"run folder: {run.out}")
+    return 0

@@ -1,0 +1,40 @@
+"""The grasp chain end to end (linear shell, tennis ball) and its bad input."""
+import json
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco")
+
+from graspdef.errors import GraspdefError
+from graspdef.pipeline import grasp_cli, run_grasp
+
+
+def test_tennis_ball_linear_chain(tmp_path):
+    """Per-finger forces at the target, loads balanced (force to round-off after adding the
+    weight), run folder complete.  Linear theory: indentation ~ F (Reissner: 2.0 mm/N for
+    this ball, ../shared/MEASURED.md), so 10.63 N gives ~20 mm."""
+    out = tmp_path / "run"
+    r = run_grasp("tennis_ball", 10.63, "point", "linear", out).result
+    for s in ("left", "right"):
+        assert r["fingers"][s]["axial_force_N"] == pytest.approx(10.63, rel=1e-6)
+        assert r["fingers"][s]["normal_force_N"] == pytest.approx(10.63, rel=0.01)
+    assert np.allclose(r["residual"]["net_force_N"], 0, atol=1e-9)
+    assert np.allclose(r["load_mapping"]["moment_defect_Nm"], 0, atol=1e-14)
+    ind = r["feedback"]["indentation_per_finger_m"]
+    assert 15e-3 < ind < 25e-3
+    for f in ("result.json", "contacts.json", "deformed.ply", "undeformed.ply"):
+        assert (out / f).is_file()
+    assert json.loads((out / "result.json").read_text())["object"] == "tennis_ball"
+
+
+def test_bad_input_leaves_nothing(tmp_path, capsys):
+    out = tmp_path / "bad"
+    assert grasp_cli(["tennis_ball", "--force", "45", "--analysis", "linear", "--out", str(out)]) == 2
+    assert "beyond what the actuator" in capsys.readouterr().err
+    assert not out.exists()
+    assert grasp_cli(["no_such_scene", "--force", "5", "--out", str(out)]) == 2
+    assert grasp_cli(["tennis_ball", "--force", "5", "--contact", "geometric", "--out", str(out)]) == 2
+    assert not out.exists() and not list(tmp_path.glob(".bad*"))
+    with pytest.raises(GraspdefError, match="no shell.toml"):
+        run_grasp("test_sphere", 5.0, "point", "linear", None)
