@@ -46,7 +46,8 @@ _GEOMETRY = {
 _SOLVER = {"backend": "str", "collocation": "int", "type": "str", "method": "str", "steps": "int",
            "max_load": "float", "targets": "list", "max_steps": "int", "max_iterations": "int", "tol": "float",
            "min_step": "float", "desired_iterations": "int", "max_growth": "float", "line_search": "bool",
-           "max_probe_displacement": "length", "refine_critical": "int"}
+           "max_probe_displacement": "length", "refine_critical": "int",
+           "reuse_factorisation": "bool", "reuse_ratio": "float"}
 _LENGTH_KEYS = {"lx", "ly", "center", "a", "b", "c", "radius", "length", "half_width", "scale"}
 
 

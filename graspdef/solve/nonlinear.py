@@ -59,6 +59,8 @@ class PathOptions:
     line_search : energy back-tracking in load control
     max_probe_displacement : [m] the path also ends (completed) once a probe has moved this far
         (for paths whose load never reaches ``max_load``, e.g. past a pressure maximum)
+    reuse_factorisation, reuse_ratio : in load control, factorise the tangent once per step and
+        reuse it while the residual contracts by reuse_ratio per iteration (modified Newton)
     refine_critical : arc-length bisections that narrow a change of stability down (each halves
         the bracket; the load factor at a limit point is then accurate to O(bracket^2))
     """
@@ -76,6 +78,8 @@ class PathOptions:
     line_search: bool = True
     max_probe_displacement: float | None = None
     refine_critical: int = 12
+    reuse_factorisation: bool = True
+    reuse_ratio: float = 0.2
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -90,6 +94,8 @@ class PathOptions:
             raise ProblemError(f"tol must lie in (0, 1e-2), got {self.tol!r}")
         if not (0 < self.min_step < 1):
             raise ProblemError(f"min_step must lie in (0, 1), got {self.min_step!r}")
+        if not (0 < self.reuse_ratio < 1):
+            raise ProblemError(f"reuse_ratio must lie in (0, 1), got {self.reuse_ratio!r}")
         if not self.max_growth > 1:
             raise ProblemError(f"max_growth must exceed 1, got {self.max_growth!r}")
         if self.max_probe_displacement is not None and not self.max_probe_displacement > 0:
@@ -218,26 +224,36 @@ class PathSolver:
         return ok, rn / scale
 
     def newton(self, u0: np.ndarray, lam: float):
-        """Equilibrium at fixed load factor from u0; returns (u, state, iterations, instability)."""
+        """Equilibrium at fixed load factor from u0; returns (u, state, iterations, instability).
+
+        The tangent is factorised at the first iteration; later iterations reuse it (modified
+        Newton: a gradient and a back-substitution each) as long as the residual contracts by
+        ``reuse_ratio`` per iteration, and refactorise when it does not (every iteration when
+        ``reuse_factorisation`` is off)."""
         eq, opt = self.eq, self.opt
         u = u0.copy()
         inst = None
-        first = None
+        first = prev = None
+        need_h = True
         for it in range(opt.max_iterations + 1):
-            st = eq.evaluate(u, lam, 2)
+            st = eq.evaluate(u, lam, 2 if need_h else 1)
             ok, rel = self._converged(st, u, lam)
             if not np.isfinite(st.energy) or not np.all(np.isfinite(st.gradient)):
                 raise _Failed(f"non-finite energy or forces at load factor {lam:.6g}")
             if ok:
-                if inst is None and it == 0:
-                    inst = eq.factor(st)
+                if inst is None:
+                    inst = eq.factor(st if st.hessian is not None else eq.evaluate(u, lam, 2))
                 return u, st, it, inst
             if it == opt.max_iterations:
                 break
             first = rel if first is None else first
             if it >= 8 and rel > 10 * first:
                 raise _Failed(f"Newton diverges at load factor {lam:.6g} (residual {rel:.2e})")
-            inst = eq.factor(st)
+            if not need_h and prev is not None and rel > opt.reuse_ratio * prev:
+                st = eq.evaluate(u, lam, 2)                 # poor contraction: fresh tangent
+                need_h = True
+            if need_h:
+                inst = eq.factor(st)
             cres = eq.constraint_residual(u, lam)
             du = eq.solve(-st.gradient, cres)
             alpha = 1.0
@@ -252,7 +268,10 @@ class PathSolver:
                     else:
                         alpha = 1.0                      # no decrease found: plain Newton step
             u = u + alpha * du
-            log.debug("  newton it %d lam %.6g rel %.2e alpha %.3g |du| %.3e E %.12e", it, lam, rel, alpha, float(np.linalg.norm(du)), st.energy)
+            log.debug("  newton it %d lam %.6g rel %.2e alpha %.3g |du| %.3e tangent %s", it, lam, rel, alpha,
+                      float(np.linalg.norm(du)), "new" if need_h else "reused")
+            prev = rel
+            need_h = not opt.reuse_factorisation
         raise _Failed(f"Newton did not converge in {opt.max_iterations} iterations at load factor "
                       f"{lam:.6g} (relative residual {rel:.2e})")
 
