@@ -1,8 +1,13 @@
 """The tennis-ball grasp at the paper's four forces (Tian & Jia 2010, Table I) through the whole
 chain (MuJoCo settle -> point loads -> shell), for linear and nonlinear shells, with and without
-the enclosed air.  Writes out/grasp_table/{table.md, table.json} and a run folder per case.
+the enclosed air, with the paper's E = 1 MPa and with E calibrated so that the linear shell
+matches the first (small-load) row.  Writes out/grasp_table/{table.md, table.json} and a run
+folder per case.
 
-    python scripts/grasp_table.py [--out out/grasp_table]
+    python scripts/grasp_table.py [--out out/grasp_table] [--cases linear,nonlinear_gas,...]
+
+Cases: linear | nonlinear_gas | nonlinear (no air) | cal_linear | cal_nonlinear | cal_nonlinear_gas
+("cal_": E = 1 MPa x linear indentation at 10.63 N / 2.56 mm; linear theory scales as 1/E).
 """
 from __future__ import annotations
 
@@ -14,40 +19,55 @@ from graspdef.pipeline import run_grasp
 
 FORCES = (10.63, 16.50, 20.37, 21.48)
 MEASURED_MM = (2.56, 6.05, 9.12, 10.27)        # paper, Table I: scanned maximum displacement
-CASES = (("linear", False), ("nonlinear", True), ("nonlinear", False))
+CASES = {"linear": ("linear", False), "nonlinear_gas": ("nonlinear", True), "nonlinear": ("nonlinear", False),
+         "cal_linear": ("linear", False), "cal_nonlinear": ("nonlinear", False),
+         "cal_nonlinear_gas": ("nonlinear", True)}
+TITLES = {"linear": "linear, E = 1 MPa", "nonlinear_gas": "neo-Hookean, E = 1 MPa, 80 kPa air",
+          "nonlinear": "neo-Hookean, E = 1 MPa, no air", "cal_linear": "linear, E calibrated",
+          "cal_nonlinear": "neo-Hookean, E calibrated, no air", "cal_nonlinear_gas": "neo-Hookean, E calibrated, 80 kPa air"}
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default="out/grasp_table")
+    ap.add_argument("--cases", default=",".join(CASES))
     a = ap.parse_args()
     out = Path(a.out)
-    rows = []
-    for f, meas in zip(FORCES, MEASURED_MM):
-        row = {"force_N": f, "measured_mm": meas}
-        for analysis, gas in CASES:
-            key = f"{analysis}{'_gas' if gas else ''}"
-            r = run_grasp("tennis_ball", f, "point", analysis, out / f"{key}_{f:g}N", gas=gas).result
+    cases = a.cases.split(",")
+    E_cal = None
+    rows = [{"force_N": f, "measured_mm": m} for f, m in zip(FORCES, MEASURED_MM)]
+    for key in cases:
+        analysis, gas = CASES[key]
+        E = None
+        if key.startswith("cal_"):
+            if E_cal is None:
+                r = run_grasp("tennis_ball", FORCES[0], "point", "linear", None, gas=False).result
+                E_cal = 1e6 * r["feedback"]["indentation_per_finger_m"] * 1e3 / MEASURED_MM[0]
+                print(f"calibrated E = {E_cal / 1e6:.3f} MPa", flush=True)
+            E = E_cal
+        for row in rows:
+            f = row["force_N"]
+            r = run_grasp("tennis_ball", f, "point", analysis, out / f"{key}_{f:g}N", gas=gas, E=E).result
             fb = r["feedback"]
             row[key] = {"indentation_mm": fb["indentation_per_finger_m"] * 1e3,
                         "max_displacement_mm": r["max_displacement_m"] * 1e3,
                         "completed": r["convergence"]["completed"],
                         "load_factor": r["convergence"].get("load_factor", 1.0),
-                        "time_s": r["timings_s"]["total"],
+                        "E_Pa": r["material"]["E_Pa"], "time_s": r["timings_s"]["total"],
                         "per_finger_N": {s: v["normal_force_N"] for s, v in r["fingers"].items()}}
             print(f, key, json.dumps(row[key]), flush=True)
-        rows.append(row)
-    lines = ["| force per finger [N] | paper, measured max. displacement [mm] | linear, no air [mm] | "
-             "nonlinear neo-Hookean + 80 kPa air [mm] | nonlinear neo-Hookean, no air [mm] |", "|---|---|---|---|---|"]
+    lines = ["| force per finger [N] | paper, measured [mm] | " + " | ".join(TITLES[k] + " [mm]" for k in cases) + " |",
+             "|---|---|" + "---|" * len(cases)]
     for row in rows:
         cells = []
-        for analysis, gas in CASES:
-            c = row[f"{analysis}{'_gas' if gas else ''}"]
+        for k in cases:
+            c = row[k]
             cells.append(f"{c['indentation_mm']:.2f}" if c["completed"] else
-                         f"path stops at {c['load_factor'] * row['force_N']:.2f} N ({c['indentation_mm']:.2f} there)")
+                         f"stops at {c['load_factor'] * row['force_N']:.2f} N ({c['indentation_mm']:.2f} there)")
         lines.append(f"| {row['force_N']:.2f} | {row['measured_mm']:.2f} | " + " | ".join(cells) + " |")
-    (out / "table.md").write_text("\n".join(lines) + "\n")
-    (out / "table.json").write_text(json.dumps(rows, indent=2) + "\n")
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "table.md").write_text(("" if E_cal is None else f"E calibrated = {E_cal / 1e6:.3f} MPa\n\n") + "\n".join(lines) + "\n")
+    (out / "table.json").write_text(json.dumps({"E_calibrated_Pa": E_cal, "rows": rows}, indent=2) + "\n")
     print("\n".join(lines))
 
 

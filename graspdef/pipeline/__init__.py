@@ -1,9 +1,16 @@
 """The grasp chain: MuJoCo scene -> settled contacts -> point loads on the shell -> linear or
-nonlinear shell solve -> run folder (graspdef.pipeline.grasp)."""
-from .grasp import GraspRun as GraspRun
-from .grasp import ShellSpec as ShellSpec
-from .grasp import grasp_cli as grasp_cli
-from .grasp import load_shell_spec as load_shell_spec
-from .grasp import run_grasp as run_grasp
+nonlinear shell solve -> run folder (graspdef.pipeline.grasp).
+
+Importing this package is cheap (the command line builds its parser from
+:mod:`graspdef.pipeline.cli_args`); the chain itself loads on first use (PEP 562)."""
+from __future__ import annotations
 
 __all__ = ["GraspRun", "ShellSpec", "grasp_cli", "load_shell_spec", "run_grasp"]
+
+
+def __getattr__(name: str):
+    if name in __all__:
+        from . import grasp
+
+        return getattr(grasp, name)
+    raise AttributeError(f"module 'graspdef.pipeline' has no attribute {name!r}")

@@ -143,11 +143,12 @@ def _rigid_fit_residual(x: np.ndarray, u: np.ndarray) -> np.ndarray:
 
 def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonlinear", out=None,
               gas: bool | None = None, settings: GraspSettings = GraspSettings(), control_faces: int | None = None,
-              steps: int | None = None) -> GraspRun:
+              steps: int | None = None, E: float | None = None) -> GraspRun:
     """Run the whole chain for ``scene`` at ``force`` [N] per finger; write the run folder ``out``
     (when given) and return its result record.
 
-    ``gas``: None = as shell.toml says; False/True forces the enclosed air off/on."""
+    ``gas``: None = as shell.toml says; False/True forces the enclosed air off/on (80 kPa gauge
+    when shell.toml has none).  ``E`` [Pa]: overrides shell.toml's Young's modulus."""
     t0 = time.perf_counter()
     if contact != "point":
         raise ProblemError(f"contact model {contact!r} is not implemented (only 'point': the paper's point loads)")
@@ -159,9 +160,14 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     spec = load_shell_spec(xml)
     if control_faces:
         spec = ShellSpec(**{**spec.__dict__, "control_faces": int(control_faces)})
-    p0 = spec.gas_p0 if gas is None else (spec.gas_p0 if gas else 0.0)
-    if gas and p0 <= 0:
-        p0 = 80e3
+    if E is not None:
+        if not (np.isfinite(E) and E > 0):
+            raise ProblemError(f"E must be a positive number of pascals, got {E!r}")
+        spec = ShellSpec(**{**spec.__dict__, "E": float(E)})
+    if gas is None:     # shell.toml's air; a linear shell cannot hold it (p V = const), so none there
+        p0 = spec.gas_p0 if analysis == "nonlinear" else 0.0
+    else:
+        p0 = (spec.gas_p0 or 80e3) if gas else 0.0
     t_setup = time.perf_counter()
     shell, shell_info = build_shell(spec, analysis)
     t_shell = time.perf_counter()
@@ -173,12 +179,11 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     loads = list(mapping.loads)
     g_obj = g.pose.vector_to_object(g.gravity)
     free = bool(g.info.get("free_object", True))
-    area = float(shell.mesh_area()) if hasattr(shell, "mesh_area") else None
-    if area is None:
-        v, f = shell.mesh.vertices, shell.mesh.faces[: shell.mesh.n_real_faces]
-        area = float(0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1).sum())
     if free:
-        loads.append(BodyForce(g.object_mass / (spec.thickness * area), tuple(g_obj)))
+        # the weight as a body force over the limit surface, with the density that gives MuJoCo's
+        # mass exactly (the quadrature's own volume t * A, not the control mesh's)
+        volume = float(BodyForce(1.0, (0.0, 0.0, 1.0)).vector(shell, shell.evaluator)[:, 2].sum())
+        loads.append(BodyForce(g.object_mass / volume, tuple(g_obj)))
         supports = [RigidModes()]
     else:
         supports = []
@@ -196,9 +201,11 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
         k = idx[int(np.argmax([np.linalg.norm(mapping.forces[i]) for i in idx]))]
         probes[s] = mapping.surface_points[k]
     problem = Problem(shell, loads, supports, probes)
-    residual_F = mapping.force_out + (g.object_mass * g_obj if free else 0.0)
-    residual_M = mapping.moment_out + (np.cross(shell.rest_positions[: shell.mesh.n_real].mean(axis=0),
-                                                g.object_mass * g_obj) if free else 0.0)
+    # net force and moment of the assembled dead loads (contacts + weight): what the rigid-mode
+    # support has to carry; zero up to MuJoCo's settling and the mass discretisation
+    fvec = problem.dead_load_vector().reshape(-1, 3)
+    residual_F = fvec.sum(axis=0)
+    residual_M = np.cross(shell.rest_positions, fvec).sum(axis=0)
     completed, stop_reason = True, None
     if analysis == "linear":
         if p0 > 0:
@@ -240,7 +247,7 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
                             "(less its soft-contact penetration); the shell says they close by 'approach'"}
     else:
         s = next(iter(probes))
-        ind = -fingers[s]["displacement_along_normal_m"]
+        ind = fingers[s]["displacement_along_normal_m"]      # along the push: positive = indented
         feedback = {"indentation_m": ind, "mujoco_tip_gap_m": g.tip_gap, "mismatch_m": ind}
     rec = {
         "scene": str(xml), "object": spec.body, "force_N": force, "contact": contact, "analysis": analysis,
@@ -302,35 +309,31 @@ def _write(out: Path, rec: dict, g, sol, x_lim, u_def) -> None:
 
 def grasp_cli(argv: list[str] | None = None) -> int:
     """``graspdef grasp SCENE --force F [--contact point|geometric] [--analysis ...] --out DIR``."""
+    from .cli_args import add_grasp_arguments
+
     ap = argparse.ArgumentParser(prog="graspdef grasp", description="MuJoCo grasp -> shell deformation run folder")
-    add_arguments(ap)
-    a = ap.parse_args(argv)
-    return run_from_args(a)
-
-
-def add_arguments(ap: argparse.ArgumentParser) -> None:
-    ap.add_argument("scene", help="scene.xml, its folder, or a name under scenes/ (e.g. tennis_ball)")
-    ap.add_argument("--force", type=float, required=True, help="squeezing force per finger [N]")
-    ap.add_argument("--contact", choices=["point", "geometric"], default="point")
-    ap.add_argument("--analysis", choices=["linear", "nonlinear"], default="nonlinear")
-    ap.add_argument("--gas", choices=["auto", "on", "off"], default="auto", help="enclosed air (shell.toml's p0)")
-    ap.add_argument("--out", required=True, help="run folder to write")
+    add_grasp_arguments(ap)
+    return run_from_args(ap.parse_args(argv))
 
 
 def run_from_args(a) -> int:
+    """Run the chain for parsed arguments (see :mod:`graspdef.pipeline.cli_args`); prints two
+    lines (the result, the run folder); a GraspdefError prints one error line, returns 2."""
     import sys
 
     gas = {"auto": None, "on": True, "off": False}[a.gas]
+    E = None if getattr(a, "E_MPa", None) is None else a.E_MPa * 1e6
     try:
-        run = run_grasp(a.scene, a.force, a.contact, a.analysis, a.out, gas=gas)
-    except GraspdefError as exc:
+        run = run_grasp(a.scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E)
+    except (GraspdefError, OSError) as exc:
         print(f"graspdef: error: {exc}", file=sys.stderr)
         return 2
     r = run.result
     fb = r["feedback"]
-    print(f"{r['object']}: {r['analysis']} {r['contact']}-load shell at {r['force_N']:g} N per finger: max displacement "
-          f"{r['max_displacement_m'] * 1e3:.3f} mm; indentation {1e3 * fb.get('indentation_per_finger_m', fb.get('indentation_m', 0)):.3f} mm"
-          f"{'' if r['convergence']['completed'] else ' (path stopped: ' + str(r['convergence']['stop_reason']) + ')'}; "
+    ind = fb.get("indentation_per_finger_m", fb.get("indentation_m", 0.0))
+    stop = "" if r["convergence"]["completed"] else f" (path stopped at load factor {r['convergence'].get('load_factor', 0):.3g})"
+    print(f"{r['object']}: {r['analysis']} shell, point loads, {r['force_N']:g} N per finger: indentation "
+          f"{ind * 1e3:.2f} mm per finger, max displacement {r['max_displacement_m'] * 1e3:.2f} mm{stop}; "
           f"{r['timings_s']['total']:.1f} s")
     print(f"run folder: {run.out}")
     return 0

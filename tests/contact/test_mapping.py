@@ -35,7 +35,7 @@ def _contacts(rng, n):
     return ContactSet(pos, -d, forces, fn, np.linalg.norm(0.3 * tang, axis=1), tuple(f"c{i % 2}" for i in range(n)))
 
 
-@pytest.mark.parametrize("n", [2, 7])
+@pytest.mark.parametrize("n", [2, 4])
 def test_total_force_and_moment_kept(shell, n):
     cs = _contacts(np.random.default_rng(n), n)
     mp = map_contacts(shell, cs)
