@@ -51,7 +51,7 @@ class LiveResult:
 class LiveModel:
     """Re-solves of one run (see the module docstring).  Not thread-safe: one worker uses it."""
 
-    def __init__(self, run: RunData, backend: str = "auto", max_iterations: int = 12, max_cuts: int = 4):
+    def __init__(self, run: RunData, backend: str = "auto", max_iterations: int = 20, max_cuts: int = 4):
         t0 = time.perf_counter()
         if run.problem_file is None:
             raise FileNotFoundError(f"{run.path}: no problem.toml")

@@ -296,6 +296,9 @@ def read_run(run_dir: str | PathLike, score_dir: str | PathLike | None = None) -
         if not (d / "path.csv").is_file():
             raise RunFolderError(f"{where} is incomplete: a nonlinear run needs path.csv")
         run.path_table = read_path_csv(d / "path.csv", ls, where)
+        if rec.get("completed") is False:
+            run.notes.append(f"the load path stopped at load factor {rec.get('load_factor', float('nan')):.4g}: "
+                             f"{rec.get('stop_reason') or 'see result.json'}")
         if (d / PATH_U_FILE).is_file():
             try:
                 u, lf, L = read_path_u(d / PATH_U_FILE)

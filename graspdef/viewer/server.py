@@ -150,6 +150,13 @@ class _RunView:
     def redraw(self) -> None:
         import trimesh
 
+        with self.v._lock:
+            if not self.v._stopped:
+                self._redraw()
+
+    def _redraw(self) -> None:
+        import trimesh
+
         v, run = self.v, self.run
         scale = float(v.scale_input.value)
         mode = v.show_dropdown.value
@@ -256,6 +263,7 @@ class Viewer:
         self._pending: dict[int, tuple[float, float]] = {}
         self._worker: threading.Thread | None = None
         self._stopped = False
+        self._syncing = False
         with contextlib.redirect_stdout(io.StringIO()):
             self.server = viser.ViserServer(host=host, port=port, verbose=False)
         self.port = self.server.get_port()
@@ -289,9 +297,10 @@ class Viewer:
 
     def stop(self) -> None:
         """Stop the worker and the server; free the port.  Safe to call twice."""
-        if self._stopped:
-            return
-        self._stopped = True
+        with self._lock:                                 # let a redraw in progress finish
+            if self._stopped:
+                return
+            self._stopped = True
         self._stop.set()
         with self._wake:
             self._wake.notify_all()
@@ -343,19 +352,24 @@ class Viewer:
 
     # ---- load path --------------------------------------------------------------------------------
     def _on_step(self, rv: _RunView) -> None:
+        with self._lock:
+            self._show_step(rv)
+
+    def _show_step(self, rv: _RunView) -> None:
         k = int(rv.step_slider.value)
-        rv.step = k
         d = rv.run.path_displacements(k) if rv.run.path_u is not None else None
         lf = rv.run.path_table.load_factors[k]
         if d is None:
             rv._update_info(f"path point {k} (load factor {lf:.4g}): the surface along the path is not "
                             "available yet (path_u.npz absent; re-solving)" if self.live else
                             "path_u.npz absent: only the final state")
+            rv.step = k
             return
         rv.disp = d
         shown = float(rv.run.path_u[1][k])
         rv.source = f"path point {k}, load factor {shown:.4g}"
         rv.redraw()
+        rv.step = k                                      # set last: the state is complete
         rv._update_info()
 
     def show_path_point(self, run: int, k: int) -> None:
@@ -395,6 +409,8 @@ class Viewer:
         rv.modulus_slider.on_update(lambda _: self._queue(rv))
 
     def _queue(self, rv: _RunView) -> None:
+        if self._syncing:
+            return
         with self._wake:
             self._pending[rv.i] = (float(rv.force_slider.value) / rv.force_ref,
                                    float(rv.modulus_slider.value) / rv.modulus_ref)
@@ -410,6 +426,13 @@ class Viewer:
         if rv.live is None:
             return None
         rv.last_result = None
+        self._syncing = True
+        try:                                             # show the request on the sliders too
+            rv.force_slider.value = float(np.clip(force_scale * rv.force_ref, rv.force_slider.min, rv.force_slider.max))
+            rv.modulus_slider.value = float(np.clip(modulus_scale * rv.modulus_ref, rv.modulus_slider.min,
+                                                    rv.modulus_slider.max))
+        finally:
+            self._syncing = False
         with self._wake:
             self._pending[run] = (force_scale, modulus_scale)
             self._wake.notify_all()
@@ -476,19 +499,20 @@ class Viewer:
                 from .live import LiveResult
                 res = LiveResult(False, None, fs, ms, None, 0.0, f"re-solve failed: {exc}")
             if res.converged:
-                rv.disp = res.displacements
-                rv.source = f"live: load × {fs:.3g}, modulus × {ms:.3g}"
-                rv.redraw()
-                rv._update_info()
-                if rv.n_path and rv.live.nonlinear and rv.run.path_table.probes:
-                    name = next(iter(rv.run.path_table.probes))
-                    p = rv.run.path_table.probes[name]
-                    comp = int(np.argmax(np.ptp(p, axis=0)))
-                    pt = self.views[i].live.problem.probes.get(name)
-                    if pt is not None:
-                        st, w = rv.live.problem.evaluator.values(pt.face, np.asarray(pt.bary))
-                        up = w @ rv.live.u.reshape(-1, 3)[st]
-                        rv._update_chart((float(up[comp] / rv.run.length_scale), float(res.load_factor)))
+                with self._lock:
+                    rv.disp = res.displacements
+                    rv.source = f"live: load × {fs:.3g}, modulus × {ms:.3g}"
+                    rv.redraw()
+                    rv._update_info()
+                    if rv.n_path and rv.live.nonlinear and rv.run.path_table.probes:
+                        name = next(iter(rv.run.path_table.probes))
+                        p = rv.run.path_table.probes[name]
+                        comp = int(np.argmax(np.ptp(p, axis=0)))
+                        pt = self.views[i].live.problem.probes.get(name)
+                        if pt is not None:
+                            st, w = rv.live.problem.evaluator.values(pt.face, np.asarray(pt.bary))
+                            up = w @ rv.live.u.reshape(-1, 3)[st]
+                            rv._update_chart((float(up[comp] / rv.run.length_scale), float(res.load_factor)))
                 rv.live_status.content = f"**converged** in {res.seconds:.2f} s — {res.message}"
             else:
                 rv.live_status.content = f"**not converged** ({res.seconds:.2f} s): {res.message}"

@@ -100,8 +100,19 @@ def test_path_slider_changes_mesh(cantilever_run):
         v.show_path_point(0, 0)
         np.testing.assert_allclose(rv.displayed, rv.to_display(rv.run.rest_vertices), atol=1e-6)
         assert "load factor" in rv.chart.content or "<svg" in rv.chart.content
+        v.show_path_point(0, k_last)
         v.scale_input.value = 0.0                                  # deformation scale 0: the rest shape
         v._redraw_all()
+        np.testing.assert_allclose(rv.displayed, rv.to_display(rv.run.rest_vertices), atol=1e-6)
+        v.scale_input.value = 2.0
+        v.show_dropdown.value = "both"
+        v._redraw_all()
+        np.testing.assert_allclose(rv.displayed, rv.to_display(rv.run.rest_vertices + 2 * rv.run.displacements),
+                                   atol=1e-5)
+        assert rv.mesh_handle.visible and rv.rest_handle.visible
+        v.show_dropdown.value = "undeformed"
+        v._redraw_all()
+        assert not rv.mesh_handle.visible and rv.rest_handle.visible
 
 
 def test_live_linear_exact_and_fast(plate_run):
@@ -118,7 +129,8 @@ def test_live_linear_exact_and_fast(plate_run):
         np.testing.assert_allclose(rv.displayed, rv.to_display(rv.run.rest_vertices + u0 / 4), atol=1e-6)
         assert "live" in rv.source and "converged" in rv.live_status.content
         assert "finger force [N]" == rv.force_slider.label and "N/mm²" in rv.modulus_slider.label
-        assert rv.modulus_slider.value == pytest.approx(2000.0)    # E shown in the run's units
+        assert rv.modulus_slider.value == pytest.approx(4 * 2000.0)    # E in the run's units, synced
+        assert rv.force_slider.value == pytest.approx(2.0)             # the run's 2 N
 
 
 def test_live_nonlinear_reaches_path_point(cantilever_run):
@@ -139,6 +151,7 @@ def test_live_nonlinear_reaches_path_point(cantilever_run):
             np.testing.assert_allclose(rv.disp, r2.displacements)  # the last converged state stays
 
 
+@pytest.mark.slow
 def test_path_resolved_when_path_u_absent(cantilever_run_no_path, cantilever_run):
     with Viewer(cantilever_run_no_path, port=0) as v:
         assert v.wait_ready(120)
