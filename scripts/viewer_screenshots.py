@@ -120,18 +120,53 @@ def save_small(driver, path: Path) -> None:
     from PIL import Image
 
     img = Image.open(io.BytesIO(driver.get_screenshot_as_png())).convert("RGB")
-    img = img.quantize(colors=128, method=Image.Quantize.MEDIANCUT)
+    img = img.quantize(colors=256, method=Image.Quantize.MEDIANCUT)
     img.save(path, optimize=True)
     print(f"{path}: {path.stat().st_size / 1e3:.0f} kB")
+
+
+def close_notices(d) -> None:
+    """Close viser's "software WebGL" notice (headless chromium renders on the CPU)."""
+    from selenium.webdriver.common.by import By
+
+    for b in d.find_elements(By.CSS_SELECTOR, "button.mantine-Notification-closeButton, "
+                                              "button[class*=CloseButton]"):
+        try:
+            b.click()
+        except Exception:  # noqa: BLE001 - a notice may vanish by itself
+            pass
+    time.sleep(2)
+
+
+def grasp_shot(runs: list[str], out: Path, docs: Path) -> None:
+    from graspdef.viewer.server import Viewer
+
+    with Viewer(runs, port=0, live=False) as v:
+        d = browser(1280, 1000, out / "chromium_profile_grasp")
+        try:
+            d.get(v.url)
+            time.sleep(6)
+            close_notices(d)
+            save_small(d, docs / "viewer_grasp.png")
+        finally:
+            d.quit()
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default="out/viewer_demo")
     ap.add_argument("--docs", default="docs")
+    ap.add_argument("--reuse", action="store_true", help="reuse the demo runs in --out if they exist")
+    ap.add_argument("--grasp", nargs="+", help="only a screenshot of these grasp run folders (graspdef grasp "
+                                                "--out), side by side: docs/viewer_grasp.png")
     args = ap.parse_args()
     out, docs = Path(args.out), Path(args.docs)
-    lin, nl = solve(out, "linear"), solve(out, "nonlinear")
+    if args.grasp:
+        grasp_shot(args.grasp, out, docs)
+        return
+    lin, nl = out / "ball_linear", out / "ball_nonlinear"
+    if not (args.reuse and (lin / "result.json").is_file() and (nl / "path_u.npz").is_file()):
+        lin, nl = solve(out, "linear"), solve(out, "nonlinear")
     synthetic_score(nl)
     from selenium.webdriver.common.by import By
 
@@ -143,13 +178,7 @@ def main() -> None:
         try:
             d.get(v.url)
             time.sleep(6)
-            for b in d.find_elements(By.CSS_SELECTOR, "button.mantine-Notification-closeButton, "
-                                                      "button[class*=CloseButton]"):
-                try:
-                    b.click()
-                except Exception:  # noqa: BLE001
-                    pass
-            time.sleep(2)
+            close_notices(d)
             save_small(d, docs / "viewer_side_by_side.png")
             v.show_path_point(1, 2)
             v.set_live(0, 2.0, 1.0)

@@ -184,7 +184,10 @@ def read_contacts(path: Path, default_length_unit: str, where: str) -> Contacts:
                       "wxyz": [1, 0, 0, 0], "size": [sx, sy, sz]}, ...],
          "contacts": [{"position": [x, y, z], "force": [fx, fy, fz], "finger": "left_pad"}, ...]}
 
-    ``point``/``at`` are accepted for ``position``, ``quaternion`` for ``wxyz``."""
+    ``point``/``at`` are accepted for ``position``, ``quaternion`` for ``wxyz``.  The grasp
+    pipeline's layout is read too: ``"frame": "world"`` with ``object_pose`` (``position_m``,
+    ``rotation`` or ``quat_wxyz``), contacts with ``position_m``/``force_N`` (moved into the object
+    frame of the surfaces) and ``per_finger`` centres (``point_m``) drawn as finger markers."""
     try:
         doc = json.loads(path.read_text())
     except (OSError, ValueError) as exc:
@@ -197,6 +200,21 @@ def read_contacts(path: Path, default_length_unit: str, where: str) -> Contacts:
     fs = {"N": 1.0, "kN": 1e3, "mN": 1e-3, "consistent": 1.0}.get(fu)
     if fs is None:
         raise RunFolderError(f"{where}: contacts.json: unknown force unit {fu!r}")
+    R, t = np.eye(3), np.zeros(3)                      # world -> object frame (grasp runs)
+    pose = doc.get("object_pose")
+    if doc.get("frame") == "world" and isinstance(pose, dict):
+        if "rotation" in pose:
+            R = np.asarray(pose["rotation"], float).reshape(3, 3)
+        elif "quat_wxyz" in pose:
+            w, x, y, z = _vec(pose["quat_wxyz"], 4, "object_pose.quat_wxyz", where) / np.linalg.norm(pose["quat_wxyz"])
+            R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                          [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                          [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+        t = _vec(pose.get("position_m", [0, 0, 0]), 3, "object_pose.position_m", where)
+
+    def to_obj(p):                                     # world point [m] -> object frame
+        return (p - t) @ R
+
     fingers = []
     for i, f in enumerate(doc.get("fingers", []) or []):
         if not isinstance(f, dict):
@@ -208,10 +226,18 @@ def read_contacts(path: Path, default_length_unit: str, where: str) -> Contacts:
                         "position": _vec(pos, 3, f"fingers[{i}].position", where) * ls,
                         "wxyz": _vec(q, 4, f"fingers[{i}].wxyz", where),
                         "size": None if size is None else np.abs(_vec(size, 3, f"fingers[{i}].size", where)) * ls})
+    for name, pf in (doc.get("per_finger") or {}).items():     # grasp runs: one marker per finger
+        if isinstance(pf, dict) and "point_m" in pf:
+            fingers.append({"name": str(name), "position": to_obj(_vec(pf["point_m"], 3, f"per_finger.{name}", where)),
+                            "wxyz": np.array([1.0, 0, 0, 0]), "size": None})
     pts, frc = [], []
     for i, c in enumerate(doc.get("contacts", []) or []):
         if not isinstance(c, dict):
             raise RunFolderError(f"{where}: contacts.json: contacts[{i}] must be an object")
+        if "position_m" in c:                                   # grasp-run records (SI)
+            pts.append(to_obj(_vec(c["position_m"], 3, f"contacts[{i}].position_m", where)))
+            frc.append(_vec(c.get("force_N"), 3, f"contacts[{i}].force_N", where) @ R)
+            continue
         p = c.get("position", c.get("point", c.get("at")))
         pts.append(_vec(p, 3, f"contacts[{i}].position", where) * ls)
         frc.append(_vec(c.get("force"), 3, f"contacts[{i}].force", where) * fs)
@@ -273,8 +299,13 @@ def read_run(run_dir: str | PathLike, score_dir: str | PathLike | None = None) -
         raise RunFolderError(f"{where}: result.json is not valid JSON: {exc}") from None
     if not isinstance(rec, dict) or "units" not in rec:
         raise RunFolderError(f"{where}: result.json has no 'units' (not a graspdef result)")
-    lu = rec["units"].get("length", "consistent")
-    fu = rec["units"].get("force", "consistent")
+    units = rec["units"]
+    if isinstance(units, str):                          # grasp runs: "SI (m, N, Pa)"
+        if not units.startswith("SI"):
+            raise RunFolderError(f"{where}: result.json: units {units!r} not understood")
+        units = {"length": "m", "force": "N"}
+    lu = units.get("length", "consistent")
+    fu = units.get("force", "consistent")
     ls = unit_scale(lu)
     dv, df, _, du = _ply(d / "deformed.ply", where)
     rv, rf, _, ru = _ply(d / "undeformed.ply", where)

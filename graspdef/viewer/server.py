@@ -341,9 +341,10 @@ class Viewer:
         self.show_dropdown.on_update(lambda _: self._redraw_all())
         self.scale_input.on_update(lambda _: self._redraw_all())
         width = x0 - 0.4
-        server.initial_camera.look_at = (width / 2, 0.0, 0.0)
         d = 0.55 + 0.45 * width
-        server.initial_camera.position = (width / 2 + 0.35 * d, -1.1 * d, 0.8 * d)
+        cx = width / 2 + 0.3 * d                         # the scene left of the GUI panel
+        server.initial_camera.look_at = (cx, 0.0, 0.0)
+        server.initial_camera.position = (cx + 0.35 * d, -1.2 * d, 0.85 * d)
         server.initial_camera.up = (0.0, 0.0, 1.0)
 
     def _redraw_all(self) -> None:
@@ -379,8 +380,8 @@ class Viewer:
         self._on_step(rv)
 
     # ---- live -----------------------------------------------------------------------------------------
-    def _add_live_gui(self, rv: _RunView) -> None:
-        gui, m = self.server.gui, rv.live
+    def _add_live_gui(self, rv: _RunView, m) -> None:
+        gui = self.server.gui
         with rv.live_folder:
             fu = rv.run.force_unit
             fs = {"N": 1.0, "kN": 1e3, "mN": 1e-3}.get(fu, 1.0)
@@ -477,8 +478,8 @@ class Viewer:
                     rv.path_ready = True
                     m.close()
                     continue
-            rv.live = m
-            self._add_live_gui(rv)
+            self._add_live_gui(rv, m)
+            rv.live = m                                  # last: the sliders exist now
             rv.live_status.content = (f"ready (set-up {m.seconds_setup:.2f} s). " +
                                       ("Linear: the sliders scale the kept solution exactly." if not m.nonlinear else
                                        "Nonlinear: Newton steps from the current state; only converged states are "

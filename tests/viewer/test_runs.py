@@ -130,3 +130,39 @@ def test_chart_svg():
     svg = layers.chart_svg(np.array([0.0, 1.0, 2.0]), np.array([0.0, 0.5, 1.0]), 1, "tip uz [mm]", "load factor",
                            extra=(1.5, 0.7))
     assert svg.startswith("<svg") and svg.count("<circle") == 5 and "tip uz [mm]" in svg
+
+
+def test_grasp_pipeline_contacts_in_world_frame(plate_run, tmp_path):
+    """The grasp pipeline's contacts.json (issue 5): world-frame records and the object pose;
+    the viewer moves them into the object frame of the surfaces."""
+    d = tmp_path / "grasp"
+    shutil.copytree(plate_run, d)
+    c, s = np.cos(0.3), np.sin(0.3)
+    R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])                       # object -> world
+    t = np.array([0.1, 0.2, 0.3])
+    p_obj, f_obj = np.array([0.0, 0.0, 0.0005]), np.array([0.0, 1.0, -2.0])
+    doc = {"frame": "world", "object_pose": {"position_m": t.tolist(), "quat_wxyz": [np.cos(0.15), 0, 0, np.sin(0.15)],
+                                             "rotation": R.tolist()},
+           "contacts": [{"finger": "left", "position_m": (R @ p_obj + t).tolist(), "force_N": (R @ f_obj).tolist(),
+                         "normal": [0, 0, 1], "normal_force_N": 2.0, "friction_force_N": 1.0}],
+           "per_finger": {"left": {"point_m": (R @ p_obj + t).tolist(), "force_N": (R @ f_obj).tolist()}}}
+    (d / "contacts.json").write_text(json.dumps(doc))
+    for pose in (doc["object_pose"], {k: v for k, v in doc["object_pose"].items() if k != "rotation"}):
+        (d / "contacts.json").write_text(json.dumps(dict(doc, object_pose=pose)))
+        run = read_run(d)
+        np.testing.assert_allclose(run.contacts.points[0], p_obj, atol=1e-12)
+        np.testing.assert_allclose(run.contacts.forces[0], f_obj, atol=1e-12)
+        assert run.contacts.fingers[0]["name"] == "left"
+        np.testing.assert_allclose(run.contacts.fingers[0]["position"], p_obj, atol=1e-12)
+    rec = json.loads((d / "result.json").read_text())
+    rec["units"] = "SI (m, N, Pa)"
+    (d / "result.json").write_text(json.dumps(rec))
+    for f in ("deformed.ply", "undeformed.ply"):                               # grasp runs write metres
+        from graspdef.viewer.runs import _ply
+        from graspdef.geometry.io import save_ply
+
+        v, fc, _, _ = _ply(plate_run / f, "x")
+        save_ply(d / f, v * 1e-3, fc, units="m")
+    run = read_run(d)
+    assert run.length_unit == "m" and run.force_unit == "N"
+    np.testing.assert_allclose(run.rest_vertices, read_run(plate_run).rest_vertices, atol=1e-15)
