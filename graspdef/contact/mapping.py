@@ -11,7 +11,10 @@ the line", exact in one step when F is normal to the surface).  What remains -- 
 projection's tolerance, a line that misses the surface -- is removed by the smallest
 (least-squares) set of force corrections dF_i at the load points with sum dF_i = 0 and
 sum x_i x dF_i = the moment defect; the corrections and the final defects are reported
-(round-off in the tests).  Point loads then enter the shell through the basis values N_i at the
+(round-off in the tests).  Contact torques (MuJoCo's torsional friction, condim 4) cannot be
+carried by forces at two points (a torque about the line through them); so each contact with a
+torque gets two auxiliary load points on the surface 3 mm to either side of it, with zero force
+before the correction, and the correction puts the couple there.  Point loads then enter the shell through the basis values N_i at the
 load point, which preserve force and moment exactly (graspdef.problem.loads).
 """
 from __future__ import annotations
@@ -81,7 +84,7 @@ def _skew(x):
 
 
 def map_contacts(shell, contacts: ContactSet, tol: float = 5e-3, about=(0.0, 0.0, 0.0),
-                 evaluator=None) -> LoadMapping:
+                 evaluator=None, couple_arm: float = 3e-3) -> LoadMapping:
     """Point loads on ``shell`` equivalent to ``contacts`` (object frame, same as the shell's).
 
     Parameters
@@ -91,6 +94,7 @@ def map_contacts(shell, contacts: ContactSet, tol: float = 5e-3, about=(0.0, 0.0
     tol : [m] largest allowed distance from a contact point to the limit surface (a contact
         farther away means the proxy and the shell disagree): ProblemError
     about : reference point of the reported moments
+    couple_arm : [m] distance of the auxiliary points that carry contact torques
 
     Returns
     -------
@@ -112,10 +116,24 @@ def map_contacts(shell, contacts: ContactSet, tol: float = 5e-3, about=(0.0, 0.0
         pts.append(ev.point(x0, sp.face, np.asarray(sp.bary)))
         dists.append(dist)
         shifts.append(s)
-    X = np.array(pts)
     F = np.array(contacts.forces, float)
+    fingers = list(contacts.finger)
+    if contacts.torques is not None:
+        for i in np.flatnonzero(np.linalg.norm(contacts.torques, axis=1) > 0):
+            n = np.asarray(contacts.normals[i], float)
+            a = np.cross(n, [1.0, 0, 0] if abs(n[0]) < 0.9 else [0, 1.0, 0])
+            a *= couple_arm / np.linalg.norm(a)
+            for sgn in (1, -1):
+                sp, dist = locate(shell, ev, contacts.positions[i] + sgn * a, "contact couple point", tol)
+                sps.append(sp)
+                pts.append(ev.point(x0, sp.face, np.asarray(sp.bary)))
+                dists.append(dist)
+                shifts.append(0.0)
+                fingers.append(contacts.finger[i])
+                F = np.vstack([F, np.zeros(3)])
+    X = np.array(pts)
     f_in = F.sum(axis=0)
-    m_in = np.cross(contacts.positions - c, F).sum(axis=0)
+    m_in = contacts.net_moment(c)
     # smallest corrections restoring force and moment (6 equations, 3n unknowns)
     A = np.zeros((6, 3 * len(X)))
     for i, x in enumerate(X):
@@ -125,7 +143,7 @@ def map_contacts(shell, contacts: ContactSet, tol: float = 5e-3, about=(0.0, 0.0
     dF = np.linalg.lstsq(A, b, rcond=None)[0].reshape(-1, 3)
     Fo = F + dF
     loads = [PointLoad(sp.face, sp.bary, tuple(float(v) for v in f)) for sp, f in zip(sps, Fo)]
-    return LoadMapping(loads, sps, X, Fo, np.asarray(contacts.positions), contacts.finger, np.array(dists),
+    return LoadMapping(loads, sps, X, Fo, np.asarray(contacts.positions), tuple(fingers), np.array(dists),
                        np.array(shifts), dF, f_in, m_in, Fo.sum(axis=0), np.cross(X - c, Fo).sum(axis=0))
 
 

@@ -64,9 +64,14 @@ class ContactSet:
     friction_force: np.ndarray
     finger: tuple[str, ...]
     geoms: tuple[tuple[str, str], ...] = field(default=())
+    #: (n_contacts, 3) contact torques ON THE OBJECT [N m] (torsional friction about the normal,
+    #: condim >= 4), or None
+    torques: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = len(self.finger)
+        if self.torques is not None and (np.shape(self.torques) != (n, 3) or not np.all(np.isfinite(self.torques))):
+            raise ProblemError(f"contact set: torques must be finite with shape ({n}, 3)")
         for name in ("positions", "normals", "forces"):
             a = getattr(self, name)
             if np.shape(a) != (n, 3) or not np.all(np.isfinite(a)):
@@ -100,16 +105,20 @@ class ContactSet:
         return self.forces.sum(axis=0)
 
     def net_moment(self, about=(0.0, 0.0, 0.0)) -> np.ndarray:
-        return np.cross(self.positions - np.asarray(about, float), self.forces).sum(axis=0)
+        """Moment of the forces about ``about`` plus the contact torques [N m]."""
+        m = np.cross(self.positions - np.asarray(about, float), self.forces).sum(axis=0)
+        return m if self.torques is None else m + self.torques.sum(axis=0)
 
     def transformed(self, pose: Pose) -> "ContactSet":
         """The same contacts expressed in the object frame of ``pose``."""
         return ContactSet(pose.to_object(self.positions), pose.vector_to_object(self.normals),
                           pose.vector_to_object(self.forces), self.normal_force, self.friction_force,
-                          self.finger, self.geoms)
+                          self.finger, self.geoms,
+                          None if self.torques is None else pose.vector_to_object(self.torques))
 
     def records(self) -> list[dict]:
         return [{"finger": self.finger[i], "position_m": self.positions[i].tolist(),
                  "normal": self.normals[i].tolist(), "force_N": self.forces[i].tolist(),
                  "normal_force_N": float(self.normal_force[i]), "friction_force_N": float(self.friction_force[i]),
+                 **({"torque_Nm": self.torques[i].tolist()} if self.torques is not None else {}),
                  **({"geoms": list(self.geoms[i])} if self.geoms else {})} for i in range(len(self))]

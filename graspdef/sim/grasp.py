@@ -92,7 +92,7 @@ def _contacts(sc: Scene, active: dict) -> ContactSet:
     mj = mujoco()
     m, d = sc.model, sc.data
     obj = set(int(g) for g in sc.object_geoms)
-    pos, nrm, frc, fn, ft, fing, geoms = [], [], [], [], [], [], []
+    pos, nrm, frc, trq, fn, ft, fing, geoms = [], [], [], [], [], [], [], []
     f6 = np.zeros(6)
     for i in range(d.ncon):
         c = d.contact[i]
@@ -113,6 +113,8 @@ def _contacts(sc: Scene, active: dict) -> ContactSet:
         pos.append(np.asarray(c.pos).copy())
         nrm.append(sign * frame[0])
         frc.append(sign * (frame.T @ f6[:3]))
+        # condim 4/6: torsional (and rolling) friction torques in the contact frame
+        trq.append(sign * (frame.T @ f6[3:6]) if c.dim >= 4 else np.zeros(3))
         fn.append(f6[0])
         ft.append(float(np.hypot(f6[1], f6[2])))
         fing.append(side)
@@ -120,7 +122,7 @@ def _contacts(sc: Scene, active: dict) -> ContactSet:
     if not fing:
         return ContactSet(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0), ())
     return ContactSet(np.array(pos), np.array(nrm), np.array(frc), np.array(fn), np.array(ft), tuple(fing),
-                      tuple(geoms))
+                      tuple(geoms), np.array(trq))
 
 
 def _speed(sc: Scene) -> float:
