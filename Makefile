@@ -9,7 +9,7 @@ STAMP  := $(VENV)/.installed
 .PHONY: setup demo test test-slow clean system-packages
 
 # Debian packages the Python dependencies need at run time (installed when run as root).
-DEB_PACKAGES := libgomp1 libusb-1.0-0
+DEB_PACKAGES := libgomp1 libusb-1.0-0 chromium chromium-driver
 
 system-packages:
 	@if [ "$$(id -u)" = "0" ] && command -v apt-get >/dev/null 2>&1; then \
@@ -21,7 +21,7 @@ $(STAMP): pyproject.toml
 	$(MAKE) system-packages
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e ".[dev,bench,register]"
+	$(PY) -m pip install -q -e ".[dev,bench,register,viewer]"
 	touch $(STAMP)
 
 setup: $(STAMP)

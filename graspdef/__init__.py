@@ -33,3 +33,11 @@ from .solve.linear import LinearSolution as LinearSolution
 from .solve.linear import solve_linear as solve_linear
 
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str):
+    if name == "view":                      # the viewer pulls in viser: import it on first use
+        from .viewer import view
+
+        return view
+    raise AttributeError(f"module 'graspdef' has no attribute {name!r}")

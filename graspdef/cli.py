@@ -2,6 +2,8 @@
 
     graspdef solve PROBLEM.toml --out DIR      solve one problem file (linear or nonlinear path)
     graspdef bench linear|nonlinear|axisym [--json FILE]   run a benchmark set, print the table
+    graspdef score PREDICTION SCAN --out DIR   register a scan to a predicted surface, score it
+    graspdef view RUN_DIR [RUN_DIR ...] [--host H] [--port P]   browse run folders (viser)
 
 Every error a user can cause prints one line ``graspdef: error: ...`` and exits with status 2.
 """
@@ -21,6 +23,7 @@ EPILOG = """examples:
   graspdef solve benchmarks/nonlinear/cantilever_moment.toml --out out/rollup
   graspdef bench nonlinear --json out/bench_nonlinear.json
   graspdef score out/ball/deformed.ply ycb_056_tennis_ball --out out/ball_score
+  graspdef view out/plate out/rollup --port 8080
 """
 
 
@@ -113,6 +116,12 @@ def _score(args: argparse.Namespace) -> int:
     return 0
 
 
+def _view(args: argparse.Namespace) -> int:
+    from .viewer import viewer_cli
+
+    return viewer_cli(args)
+
+
 def _progress(args: argparse.Namespace, msg: str) -> None:
     if not getattr(args, "quiet", False):
         print(f"[graspdef] {msg}", file=sys.stderr, flush=True)
@@ -151,6 +160,11 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--region", help="undeformed region to align on, e.g. 'z < -10' (prediction units)")
     c.add_argument("--surface-offset-mm", type=float, default=0.0, help="mid-surface to outer-surface offset [mm]")
     c.set_defaults(func=_score)
+    from .viewer.cli import add_arguments as add_view_arguments
+    w = sub.add_parser("view", help="serve run folders in the browser (viser on 127.0.0.1:8080)",
+                       description="Serve run folders as a viser page (127.0.0.1 unless --host); Ctrl-C stops it.")
+    add_view_arguments(w)
+    w.set_defaults(func=_view)
     return ap
 
 

@@ -17,6 +17,7 @@ from ..geometry.io import save_ply
 from ..problem.config import ProblemSpec
 from .linear import LinearSolution
 from .nonlinear import NonlinearSolution
+from .pathfile import write_solution_path
 
 
 def _energy_unit(spec: ProblemSpec) -> str:
@@ -118,8 +119,8 @@ def result_record(spec: ProblemSpec, sol: LinearSolution | NonlinearSolution) ->
 
 def write_run(out: str | Path, spec: ProblemSpec, sol: LinearSolution | NonlinearSolution, config_text: str) -> Path:
     """Write result.json, deformed.ply, undeformed.ply (the limit surface at rest: the baseline
-    of scan scores), the problem file (and path.csv for a nonlinear path) into ``out``
-    atomically."""
+    of scan scores), the problem file (and, for a nonlinear path, path.csv and path_u.npz -- the
+    control-point displacements of every point, for the viewer) into ``out`` atomically."""
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
@@ -139,6 +140,7 @@ def write_run(out: str | Path, spec: ProblemSpec, sol: LinearSolution | Nonlinea
                 w = csv.writer(fh)
                 w.writerow(header)
                 w.writerows(rows)
+            write_solution_path(tmp, sol)
         if out.exists():
             shutil.rmtree(out)
         tmp.rename(out)

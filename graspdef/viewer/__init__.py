@@ -4,9 +4,9 @@ starts; reading run folders (:mod:`.runs`) and the drawing helpers (:mod:`.layer
 scipy and trimesh only."""
 from __future__ import annotations
 
-from .pathfile import read_path_u as read_path_u
-from .pathfile import write_path_u as write_path_u
-from .pathfile import write_solution_path as write_solution_path
+from ..solve.pathfile import read_path_u as read_path_u
+from ..solve.pathfile import write_path_u as write_path_u
+from ..solve.pathfile import write_solution_path as write_solution_path
 from .runs import RunData as RunData
 from .runs import RunFolderError as RunFolderError
 from .runs import read_run as read_run

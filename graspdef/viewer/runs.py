@@ -4,7 +4,7 @@ Required: ``result.json``, ``deformed.ply`` and ``undeformed.ply`` (same vertex 
 for a nonlinear run also ``path.csv``.  Optional, used when present and skipped when absent:
 
 * ``problem.toml`` -- rebuilds the Problem for live re-solves and for the surface along the path;
-* ``path_u.npz`` -- control-point displacements of every path point (:mod:`.pathfile`);
+* ``path_u.npz`` -- control-point displacements of every path point (:mod:`graspdef.solve.pathfile`);
 * ``contacts.json`` -- grasp contacts (see :func:`read_contacts` for the accepted layout);
 * ``score.json`` with ``scan_errors.ply`` -- a scan score (``graspdef score``), in the run folder
   or in one of its sub-folders, or given explicitly.
@@ -26,8 +26,8 @@ import trimesh
 
 from ..errors import GraspdefError
 from ..geometry.io import LENGTH_UNITS
-from .pathfile import FILENAME as PATH_U_FILE
-from .pathfile import read_path_u
+from ..solve.pathfile import FILENAME as PATH_U_FILE
+from ..solve.pathfile import read_path_u
 
 log = logging.getLogger(__name__)
 

@@ -9,7 +9,7 @@ import pytest
 
 from graspdef.errors import GraspdefError
 from graspdef.viewer import layers
-from graspdef.viewer.pathfile import read_path_u, write_path_u
+from graspdef.solve.pathfile import read_path_u, write_path_u
 from graspdef.viewer.runs import RunFolderError, read_run
 
 
