@@ -401,7 +401,8 @@ class PathSolver:
             u_prev, lam_prev, u, lam = u, lam, u_new, lam_new
             if abs(lam - lam_end) <= 1e-12 * abs(lam_end) or self._far(pt):
                 return
-            growth = np.clip(np.sqrt(opt.desired_iterations / max(its, 1)), 0.5, opt.max_growth)
+            # shrink only on failure (above); grow after easy steps
+            growth = np.clip(np.sqrt(opt.desired_iterations / max(its, 1)), 1.0, opt.max_growth)
             dlam = step * growth if abs(step) >= abs(dlam) * 0.999 else dlam
         raise _Failed(f"the path needed more than max_steps={opt.max_steps} steps (reached load factor {lam:.6g})")
 
