@@ -113,7 +113,7 @@ def load_shell_spec(scene_xml: Path) -> ShellSpec:
 
 def build_shell(spec: ShellSpec, analysis: str) -> tuple[Shell, dict]:
     scan = load_scan(spec.scan)
-    outer, rep = control_mesh(scan, spec.control_faces, spec.remesh)
+    outer, rep = control_mesh(scan, spec.control_faces, spec.remesh, relax=int(spec.raw.get("shell", {}).get("relax", 0)))
     mid = mid_surface(outer, spec.thickness)
     return Shell(mid.vertices, mid.faces, spec.material(analysis), spec.thickness), {
         "scan": spec.scan, "control_faces": int(len(mid.faces)), "control_vertices": int(len(mid.vertices)),
