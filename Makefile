@@ -21,13 +21,14 @@ $(STAMP): pyproject.toml
 	$(MAKE) system-packages
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e ".[dev,bench,register,viewer]"
+	$(PY) -m pip install -q -e ".[dev,bench,register,viewer,sim]"
 	touch $(STAMP)
 
 setup: $(STAMP)
 
 demo: setup
-	$(VENV)/bin/graspdef bench linear --json out/bench_linear.json
+	$(VENV)/bin/graspdef grasp tennis_ball --force 21.48 --out out/demo_tennis_ball
+	@echo "look at it: $(VENV)/bin/graspdef view out/demo_tennis_ball"
 
 test: setup
 	$(PY) -m pytest -q -m "not slow"

@@ -2,6 +2,7 @@
 
     graspdef solve PROBLEM.toml --out DIR      solve one problem file (linear or nonlinear path)
     graspdef bench linear|nonlinear|axisym [--json FILE]   run a benchmark set, print the table
+    graspdef grasp SCENE --force F --out DIR   MuJoCo grasp, contacts mapped onto the shell, solved
     graspdef score PREDICTION SCAN --out DIR   register a scan to a predicted surface, score it
     graspdef view RUN_DIR [RUN_DIR ...] [--host H] [--port P]   browse run folders (viser)
 
@@ -23,6 +24,7 @@ EPILOG = """examples:
   graspdef solve benchmarks/nonlinear/cantilever_moment.toml --out out/rollup
   graspdef bench nonlinear --json out/bench_nonlinear.json
   graspdef score out/ball/deformed.ply ycb_056_tennis_ball --out out/ball_score
+  graspdef grasp tennis_ball --force 21.48 --out out/grasp_tennis_ball
   graspdef view out/plate out/rollup --port 8080
 """
 
@@ -116,6 +118,12 @@ def _score(args: argparse.Namespace) -> int:
     return 0
 
 
+def _grasp(args: argparse.Namespace) -> int:
+    from .pipeline.grasp import run_from_args
+
+    return run_from_args(args)
+
+
 def _view(args: argparse.Namespace) -> int:
     from .viewer import viewer_cli
 
@@ -160,6 +168,12 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--region", help="undeformed region to align on, e.g. 'z < -10' (prediction units)")
     c.add_argument("--surface-offset-mm", type=float, default=0.0, help="mid-surface to outer-surface offset [mm]")
     c.set_defaults(func=_score)
+    from .pipeline.cli_args import add_grasp_arguments
+    gr = sub.add_parser("grasp", help="MuJoCo grasp -> contacts -> shell deformation (a run folder)",
+                        description="Close the scene's gripper to the force per finger, settle, map the contacts "
+                                    "onto the object's shell and solve; writes a run folder.")
+    add_grasp_arguments(gr)
+    gr.set_defaults(func=_grasp)
     from .viewer.cli import add_arguments as add_view_arguments
     w = sub.add_parser("view", help="serve run folders in the browser (viser on 127.0.0.1:8080)",
                        description="Serve run folders as a viser page (127.0.0.1 unless --host); Ctrl-C stops it.")
