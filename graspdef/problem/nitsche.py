@@ -10,7 +10,7 @@ across the edge has no component along n0.  The energy term is
 with the bending moment m_nn = m^ab nu_a nu_b of the *current* state (m^ab = dW/dk_ab from the
 material) -- the consistency term that makes the weak form exact at any deformation -- and the
 penalty gamma D / h (D = E t^3 / (12 (1 - nu^2)) with the material's small-strain moduli, h the
-edge length).  At rest its Hessian is the linear Nitsche matrix (``supports.nitsche_matrix``).
+edge length).  At rest its Hessian is the linear Nitsche matrix (``Problem.boundary_stiffness``).
 In the Hessian, the term theta * (third derivative of W) is formed from central differences of
 the material tangent (zero for Saint Venant-Kirchhoff; it vanishes at the exact solution,
 theta = 0, in any case); everything else is analytic.  Using the *linearised* moment instead (the

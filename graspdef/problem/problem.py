@@ -12,7 +12,8 @@ from ..shell.model import Shell
 from ..subdivision.evaluate import SurfaceEvaluator, project_point
 from .loads import PointLoad, load_vector
 from .potentials import EnclosedGas, is_potential
-from .supports import RigidModes, check_rigid_modes, constraint_rows, independent_rows, nitsche_matrix, three_point_supports
+from .nitsche import NitscheRotation
+from .supports import RigidModes, check_rigid_modes, constraint_rows, independent_rows, three_point_supports
 
 
 #: sparse solver back-ends a problem may ask for (graspdef.solve.sparse implements them)
@@ -109,7 +110,7 @@ class Problem:
 
     def boundary_stiffness(self):
         """Nitsche terms for rotation-fixed edges, (3 n_control, 3 n_control) sparse."""
-        return nitsche_matrix(self.shell, self.supports, self.evaluator)
+        return NitscheRotation(self.shell, self.supports, self.evaluator).evaluate(self.shell.rest_positions)[2]
 
     def constraints(self, with_targets: bool = False, rigid: str = "orthogonal"):
         """C (m, 3 n_control) and row labels (and, ``with_targets``, the prescribed values g (m,)
