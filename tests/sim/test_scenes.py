@@ -4,7 +4,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-mujoco = pytest.importorskip("mujoco")
+import mujoco
 
 SCENES = sorted((Path(__file__).resolve().parents[2] / "scenes").glob("*/scene*.xml"))
 

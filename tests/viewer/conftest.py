@@ -79,7 +79,6 @@ steps = 4
 def _solve(folder: Path, text: str, path_u: bool = True) -> Path:
     from graspdef.problem.config import load_problem
     from graspdef.solve.output import write_run
-    from graspdef.viewer import write_solution_path
 
     src = folder.parent / f"{folder.name}.toml"
     src.write_text(text)
@@ -92,9 +91,9 @@ def _solve(folder: Path, text: str, path_u: bool = True) -> Path:
         from graspdef.solve.linear import solve_linear
 
         sol = solve_linear(spec.problem)
-    write_run(folder, spec, sol, text)
-    if path_u and spec.solver.get("type") == "nonlinear":
-        write_solution_path(folder, sol)
+    write_run(folder, spec, sol, text)                 # nonlinear runs include path_u.npz
+    if not path_u:
+        (folder / "path_u.npz").unlink(missing_ok=True)     # an older run folder, without it
     return folder
 
 

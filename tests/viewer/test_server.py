@@ -9,7 +9,7 @@ import time
 import numpy as np
 import pytest
 
-pytest.importorskip("viser")
+import viser  # noqa: F401  (the viewer extra is part of make test)
 
 from graspdef.viewer.cli import main as view_main  # noqa: E402
 from graspdef.viewer.runs import RunFolderError  # noqa: E402
