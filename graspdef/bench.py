@@ -63,15 +63,18 @@ def run_benchmark(path: Path) -> dict:
     }
 
 
-def run_linear_benchmarks(folder: Path, pattern: str = "*",
-                          progress: Callable[[str], None] = lambda m: None) -> list[dict]:
+def benchmark_files(folder: Path, pattern: str = "*") -> list[Path]:
+    """The problem files of a benchmark folder whose names match ``pattern`` (a glob)."""
     files = sorted(folder.glob("*.toml"))
     if not files:
         raise ProblemError(f"no benchmark files (*.toml) in {folder}")
+    return [f for f in files if fnmatch.fnmatch(f.stem, pattern)]
+
+
+def run_linear_benchmarks(folder: Path, pattern: str = "*",
+                          progress: Callable[[str], None] = lambda m: None) -> list[dict]:
     records = []
-    for f in files:
-        if not fnmatch.fnmatch(f.stem, pattern):
-            continue
+    for f in benchmark_files(folder, pattern):
         progress(f"benchmark {f.stem} ...")
         r = run_benchmark(f)
         progress(f"  {r['name']}: {r['value']:.6g} vs {r['reference']:.6g} ({100 * r['rel_error']:+.2f} %), "
@@ -245,13 +248,8 @@ def _curve_records(spec, sol, ref, levels, values, record):
 
 def run_nonlinear_benchmarks(folder: Path, pattern: str = "*",
                              progress: Callable[[str], None] = lambda m: None) -> list[dict]:
-    files = sorted(folder.glob("*.toml"))
-    if not files:
-        raise ProblemError(f"no benchmark files (*.toml) in {folder}")
     records = []
-    for f in files:
-        if not fnmatch.fnmatch(f.stem, pattern):
-            continue
+    for f in benchmark_files(folder, pattern):
         progress(f"benchmark {f.stem} ...")
         rs = run_nonlinear_benchmark(f, progress)
         worst = max(rs, key=lambda r: abs(r["rel_error"]) if np.isfinite(r["rel_error"]) else np.inf)
