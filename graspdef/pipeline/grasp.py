@@ -24,8 +24,6 @@ import argparse
 import csv
 import json
 import logging
-import shutil
-import tempfile
 import time
 import tomllib
 from dataclasses import dataclass, field
@@ -35,7 +33,7 @@ import numpy as np
 
 from ..contact.mapping import map_contacts
 from ..errors import GraspdefError, ProblemError
-from ..geometry.io import save_ply
+from ..geometry.io import atomic_folder, save_ply
 from ..problem.loads import BodyForce
 from ..problem.potentials import EnclosedGas
 from ..problem.problem import Problem
@@ -280,9 +278,7 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
 
 
 def _write(out: Path, rec: dict, g, sol, x_lim, u_def) -> None:
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
+    with atomic_folder(out) as tmp:
         rec = dict(rec, files={"deformed": "deformed.ply", "undeformed": "undeformed.ply", "contacts": "contacts.json"})
         (tmp / "result.json").write_text(json.dumps(rec, indent=2, default=float) + "\n")
         (tmp / "contacts.json").write_text(json.dumps({
@@ -299,12 +295,6 @@ def _write(out: Path, rec: dict, g, sol, x_lim, u_def) -> None:
                 w.writerow(["point", "load_factor", "newton_iterations"] + [f"{n}_u{c}[m]" for n in names for c in "xyz"])
                 for i, p in enumerate(sol.path):
                     w.writerow([i, p.load_factor, p.iterations] + [float(v) for n in names for v in p.probes[n]])
-        if out.exists():
-            shutil.rmtree(out)
-        tmp.rename(out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
 
 
 def grasp_cli(argv: list[str] | None = None) -> int:

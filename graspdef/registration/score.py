@@ -13,8 +13,6 @@ too); and the rigid transform found.
 from __future__ import annotations
 
 import json
-import shutil
-import tempfile
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
@@ -23,6 +21,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from graspdef.geometry import TriMesh, compile_predicate, length_scale, save_ply
+from graspdef.geometry.io import atomic_folder
 from graspdef.registration.distance import SurfaceDistance
 from graspdef.registration.icp import (
     Registration,
@@ -257,9 +256,7 @@ def score_cli(prediction_path: str | PathLike, scan_path: str | PathLike,
         "files": {"scan_errors": "scan_errors.ply", "prediction_errors": "prediction_errors.ply",
                   "undeformed_errors": "undeformed_errors.ply"},
     }
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
+    with atomic_folder(out) as tmp:
         (tmp / "score.json").write_text(json.dumps(record, indent=2) + "\n")
         save_ply(tmp / "scan_errors.ply", sv, sf, units=s_units,
                  vertex_scalars={"error_mm": pred.scan_errors * MM,
@@ -268,11 +265,5 @@ def score_cli(prediction_path: str | PathLike, scan_path: str | PathLike,
                  vertex_scalars={"distance_to_scan_mm": pred.surface_errors * MM})
         save_ply(tmp / "undeformed_errors.ply", uv, uf, units=u_units,
                  vertex_scalars={"distance_to_scan_mm": base.surface_errors * MM})
-        if out.exists():
-            shutil.rmtree(out)
-        tmp.rename(out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return record
 

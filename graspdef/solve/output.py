@@ -7,13 +7,11 @@ from __future__ import annotations
 
 import csv
 import json
-import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from ..geometry.io import save_ply
+from ..geometry.io import atomic_folder, save_ply
 from ..problem.config import ProblemSpec
 from .linear import LinearSolution
 from .nonlinear import NonlinearSolution
@@ -121,10 +119,7 @@ def write_run(out: str | Path, spec: ProblemSpec, sol: LinearSolution | Nonlinea
     """Write result.json, deformed.ply, undeformed.ply (the limit surface at rest: the baseline
     of scan scores), the problem file (and, for a nonlinear path, path.csv and path_u.npz -- the
     control-point displacements of every point, for the viewer) into ``out`` atomically."""
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
+    with atomic_folder(out) as tmp:
         rec = result_record(spec, sol)
         (tmp / "result.json").write_text(json.dumps(rec, indent=2) + "\n")
         verts, faces = sol.deformed_surface()
@@ -141,10 +136,4 @@ def write_run(out: str | Path, spec: ProblemSpec, sol: LinearSolution | Nonlinea
                 w.writerow(header)
                 w.writerows(rows)
             write_solution_path(tmp, sol)
-        if out.exists():
-            shutil.rmtree(out)
-        tmp.rename(out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    return out
+    return Path(out)

@@ -67,3 +67,23 @@ def test_save_ply_rejects_bad_scalars(tmp_path):
     with pytest.raises(ProblemError, match="name"):
         save_ply(tmp_path / "a.ply", mesh.vertices, mesh.faces,
                  vertex_scalars={"bad name": np.zeros(mesh.n_vertices)})
+
+
+def test_atomic_folder_replaces_only_on_success(tmp_path):
+    """A folder written through atomic_folder appears whole or not at all: an error inside the
+    block leaves the previous folder untouched and no temporary folder behind."""
+    from graspdef.geometry.io import atomic_folder
+
+    out = tmp_path / "run"
+    with atomic_folder(out) as d:
+        (d / "a.txt").write_text("first")
+    assert (out / "a.txt").read_text() == "first"
+    with pytest.raises(RuntimeError):
+        with atomic_folder(out) as d:
+            (d / "a.txt").write_text("second")
+            raise RuntimeError("boom")
+    assert (out / "a.txt").read_text() == "first"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]
+    with atomic_folder(out) as d:
+        (d / "b.txt").write_text("third")
+    assert sorted(p.name for p in out.iterdir()) == ["b.txt"]
