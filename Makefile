@@ -21,7 +21,7 @@ $(STAMP): pyproject.toml
 	$(MAKE) system-packages
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e ".[dev,bench,register,viewer,sim]"
+	$(PY) -m pip install -q -e ".[dev,bench,register,viewer,sim,sweep]"
 	touch $(STAMP)
 
 setup: $(STAMP)
