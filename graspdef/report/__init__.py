@@ -1,9 +1,13 @@
 """HTML reports of run folders (issue 6): headless surface pictures (:mod:`.render`), plots
-(:mod:`.plots`), the self-contained page (:mod:`.html`) and ``graspdef report`` (:mod:`.cli`).
-matplotlib (Agg) only; open3d only through :mod:`graspdef.registration`."""
+(:mod:`.plots`), the self-contained page (:mod:`.html`), the report itself (:mod:`.build`) and
+``graspdef report`` (:mod:`.cli`).  matplotlib (Agg, object-oriented API) only; open3d only
+through :mod:`graspdef.registration`, and only when a scan is scored."""
 from __future__ import annotations
 
+from .build import PAPER_TABLE_I as PAPER_TABLE_I
+from .build import ReportError as ReportError
+from .build import build_report as build_report
 from .render import VIEWS as VIEWS
 from .render import render_surface as render_surface
 
-__all__ = ["VIEWS", "render_surface"]
+__all__ = ["PAPER_TABLE_I", "ReportError", "VIEWS", "build_report", "render_surface"]

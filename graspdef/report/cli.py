@@ -1,0 +1,56 @@
+"""``graspdef report RUN_DIR [RUN_DIR ...] [--out FILE] [--scan ID_or_FILE] [--table FILE]``."""
+from __future__ import annotations
+
+import argparse
+import sys
+
+
+def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """The ``report`` sub-command's arguments (call on the sub-parser)."""
+    p.add_argument("run_dirs", nargs="*", metavar="RUN_DIR",
+                   help="run folders (graspdef solve/grasp --out); several grasp runs make the Table I comparison")
+    p.add_argument("--out", help="HTML file to write (default: RUN_DIR/report.html of the first run)")
+    p.add_argument("--scan", metavar="ID_or_FILE",
+                   help="score every run against this scan first (a scan file or a scans/manifest.toml id); "
+                        "written to RUN_DIR/score")
+    p.add_argument("--scan-units", help="length unit of the scan file (default: its 'comment units' line)")
+    p.add_argument("--surface-offset-mm", type=float, default=None,
+                   help="mid-surface to scanned-surface offset for --scan [mm] (default: half the grasp run's "
+                        "shell thickness, else 0)")
+    p.add_argument("--table", metavar="FILE",
+                   help="CSV with columns run[,force_N][,measured_mm]: more run folders for the Table I "
+                        "comparison (paths relative to the CSV)")
+    p.add_argument("--title", help="page title")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    """Write the report; errors are GraspdefError subclasses (one line, exit status 2 in graspdef's
+    main)."""
+    from .build import build_report
+
+    def say(msg: str) -> None:
+        if not getattr(args, "quiet", False):
+            print(f"[graspdef] {msg}", file=sys.stderr, flush=True)
+
+    out = build_report(args.run_dirs, args.out, scan=args.scan, table=args.table, title=args.title,
+                       surface_offset_mm=args.surface_offset_mm, scan_units=args.scan_units, progress=say)
+    say(f"wrote {out}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Stand-alone entry (``python -m graspdef.report.cli RUN_DIR``)."""
+    from ..errors import GraspdefError
+
+    ap = add_arguments(argparse.ArgumentParser(prog="graspdef report", description="Write an HTML report of run folders."))
+    args = ap.parse_args(argv)
+    try:
+        return run(args)
+    except (GraspdefError, OSError) as exc:
+        print(f"graspdef: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
