@@ -22,6 +22,7 @@ from scipy.spatial import cKDTree
 
 from graspdef.geometry import TriMesh, compile_predicate, length_scale, save_ply
 from graspdef.geometry.io import atomic_folder
+from graspdef.geometry.provenance import write_provenance
 from graspdef.registration.distance import SurfaceDistance
 from graspdef.registration.icp import (
     Registration,
@@ -258,6 +259,7 @@ def score_cli(prediction_path: str | PathLike, scan_path: str | PathLike,
     }
     with atomic_folder(out) as tmp:
         (tmp / "score.json").write_text(json.dumps(record, indent=2) + "\n")
+        write_provenance(tmp, {"inputs": record["inputs"], "options": record["options"]})
         save_ply(tmp / "scan_errors.ply", sv, sf, units=s_units,
                  vertex_scalars={"error_mm": pred.scan_errors * MM,
                                  "baseline_error_mm": base.scan_errors * MM})

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.io import atomic_folder, save_ply
+from ..geometry.provenance import write_provenance
 from ..problem.config import ProblemSpec
 from .linear import LinearSolution
 from .nonlinear import NonlinearSolution
@@ -129,6 +130,8 @@ def write_run(out: str | Path, spec: ProblemSpec, sol: LinearSolution | Nonlinea
         L = sol.limit_map()
         save_ply(tmp / "undeformed.ply", L @ sol.problem.shell.mesh.vertices, faces, units=spec.length_unit)
         (tmp / "problem.toml").write_text(config_text)
+        write_provenance(tmp, {"problem_file": "problem.toml", "name": spec.name, "backend": spec.backend,
+                               "text": config_text})
         if isinstance(sol, NonlinearSolution):
             header, rows = path_rows(spec, sol)
             with open(tmp / "path.csv", "w", newline="") as fh:
