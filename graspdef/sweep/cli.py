@@ -1,0 +1,48 @@
+"""``graspdef sweep SPEC.toml --out DIR [--workers N | --scheduler tcp://HOST:PORT]``
+(kept free of heavy imports: the parser is built at start-up)."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Callable
+
+from ..errors import ProblemError
+
+
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    ap.add_argument("spec", help="sweep spec (.toml), or an existing sweep folder to resume (its spec.toml)")
+    ap.add_argument("--out", help="sweep folder (created, or resumed: finished cases are not recomputed); "
+                                  "default: the folder given as SPEC")
+    where = ap.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, default=2,
+                       help="worker processes of the embedded local cluster (default 2; 1 thread each)")
+    where.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                       help="run on this dask.distributed cluster instead (workers need graspdef and the "
+                            "sweep folder on a shared filesystem)")
+    ap.add_argument("--retry-failed", action="store_true", help="rerun cases recorded as failed")
+    ap.add_argument("--parquet", action="store_true", help="also write results.parquet (needs pyarrow)")
+    ap.add_argument("--connect-timeout", type=float, default=5.0, metavar="S",
+                    help="seconds to wait for the scheduler and its first worker (default 5)")
+
+
+def run_from_args(args: argparse.Namespace, progress: Callable[[str], None] | None = None) -> int:
+    """Run the sweep for parsed arguments; prints one line (the summary); 0 when every case is
+    done, 1 when some failed (their errors are in summary.md and results.csv)."""
+    from .run import run_sweep
+    from .spec import load_spec
+
+    src = Path(args.spec)
+    if src.is_dir():
+        if not (src / "spec.toml").is_file():
+            raise ProblemError(f"{src} is a folder without spec.toml: give a sweep spec file or a sweep folder")
+        spec_file, out = src / "spec.toml", Path(args.out or src)
+    else:
+        if not args.out:
+            raise ProblemError("give --out DIR (the sweep folder) for a new sweep")
+        spec_file, out = src, Path(args.out)
+    spec = load_spec(spec_file)
+    res = run_sweep(spec, out, scheduler=args.scheduler, workers=args.workers, retry_failed=args.retry_failed,
+                    parquet=args.parquet, connect_timeout=args.connect_timeout, progress=progress)
+    print(f"{spec.name}: {res.n_done} done, {res.n_failed} failed of {res.n_cases} cases "
+          f"({res.n_run} run now, {res.n_skipped} reused); {res.out / 'results.csv'}, {res.out / 'summary.md'}")
+    return 0 if res.n_failed == 0 and res.n_done == res.n_cases else 1
