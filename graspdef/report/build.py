@@ -474,4 +474,4 @@ def build_report(run_dirs, out: str | PathLike | None = None, *, scan: str | Non
 
 
 __all__ = ["PAPER_TABLE_I", "ReportError", "RunReport", "build_report", "load_run", "read_table_file",
-           "score_run", "table_rows", "line_chart"]
+           "score_run", "table_rows"]

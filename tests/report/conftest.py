@@ -1,0 +1,142 @@
+"""Small run folders written through the real solve path (a linear ball in mm/N, a nonlinear
+cantilever in consistent units) and a synthetic scan of the ball's deformed surface (scanner
+model), shared by the report tests."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+BALL_MM = """
+name = "ball_mm"
+[units]
+length = "mm"
+force = "N"
+[geometry]
+type = "sphere"
+radius = 32.5
+subdivisions = 2
+[material]
+E = 8.0             # N/mm^2 = 8 MPa
+nu = 0.45
+[shell]
+thickness = 2.5
+[[supports]]
+kind = "rigid_modes"
+[[loads]]
+kind = "point"
+at = [0.0, 0.0, 32.5]
+force = [0.0, 0.0, -10.63]
+[[loads]]
+kind = "point"
+at = [0.0, 0.0, -32.5]
+force = [0.0, 0.0, 10.63]
+[[probes]]
+name = "top"
+at = [0.0, 0.0, 32.5]
+"""
+
+CANTILEVER = """
+name = "cantilever_small"
+[units]
+length = "consistent"
+force = "consistent"
+[geometry]
+type = "rectangle"
+lx = 10.0
+ly = 1.0
+nx = 6
+ny = 2
+center = [5.0, 0.5]
+[material]
+model = "saint_venant_kirchhoff"
+E = 1.2e6
+nu = 0.0
+[shell]
+thickness = 0.1
+[regions]
+root = "abs(x) < 1e-9"
+tip = "abs(x - 10) < 1e-9"
+[[supports]]
+kind = "clamped"
+region = "root"
+[[loads]]
+kind = "edge_load"
+region = "tip"
+force = [0.0, 0.0, 0.1]
+[[probes]]
+name = "tip"
+at = [10.0, 0.5, 0.0]
+[solver]
+type = "nonlinear"
+method = "load"
+steps = 3
+"""
+
+
+def solve_into(folder: Path, text: str) -> Path:
+    """``graspdef solve`` of a problem text into ``folder`` (the real writer)."""
+    from graspdef.problem.config import load_problem
+    from graspdef.solve.output import write_run
+
+    src = folder.parent / f"{folder.name}.toml"
+    src.write_text(text)
+    spec = load_problem(src)
+    if spec.solver.get("type") == "nonlinear":
+        from graspdef.solve.nonlinear import path_options, solve_nonlinear
+
+        sol = solve_nonlinear(spec.problem, path_options(spec.solver))
+    else:
+        from graspdef.solve.linear import solve_linear
+
+        sol = solve_linear(spec.problem)
+    write_run(folder, spec, sol, text)
+    return folder
+
+
+@pytest.fixture(scope="session")
+def report_root(tmp_path_factory) -> Path:
+    return tmp_path_factory.mktemp("report_runs")
+
+
+@pytest.fixture(scope="session")
+def ball_run(report_root) -> Path:
+    """Linear ball (R = 32.5 mm, 162 control vertices) squeezed by 10.63 N at its poles."""
+    return solve_into(report_root / "ball", BALL_MM)
+
+
+@pytest.fixture(scope="session")
+def cantilever_run(report_root) -> Path:
+    return solve_into(report_root / "cantilever", CANTILEVER)
+
+
+@pytest.fixture(scope="session")
+def ball_scan(report_root, ball_run) -> Path:
+    """A synthetic scan (scanner model: 6 views, holes, sigma = 0.127 mm, random pose; 4,000
+    points, metres) of the ball's deformed surface moved 0.3 mm outward: a known shape error."""
+    import trimesh
+
+    from graspdef.geometry import TriMesh
+    from graspdef.scans import Scanner, scan_surface, write_scan
+
+    m = trimesh.load(ball_run / "deformed.ply", process=False)
+    v = np.asarray(m.vertices) * 1e-3
+    n = v - v.mean(axis=0)
+    v = v + 3e-4 * n / np.linalg.norm(n, axis=1, keepdims=True)
+    scan = scan_surface(TriMesh(v, np.asarray(m.faces)), Scanner(n_points=4000), seed=3)
+    return write_scan(scan, report_root / "scans" / "ball_scan.ply", units="m")
+
+
+@pytest.fixture(scope="session")
+def scored_report(ball_run, ball_scan, tmp_path_factory) -> Path:
+    """A copy of the ball's run folder with its report, scored against the synthetic scan through
+    ``--scan`` (the score written to RUN/score)."""
+    import shutil
+
+    from graspdef.report.cli import main as report_main
+
+    d = tmp_path_factory.mktemp("scored") / "ball"
+    shutil.copytree(ball_run, d)
+    assert report_main([str(d), "--scan", str(ball_scan)]) == 0
+    return d
