@@ -11,6 +11,7 @@ import pytest
 
 from graspdef.errors import GraspdefError
 from graspdef.report.build import ReportError, build_report
+from graspdef.report.cli import main as report_main
 
 
 def _self_contained(text: str) -> None:
@@ -88,8 +89,6 @@ def test_flagged_score_is_shown(scored_report, tmp_path):
     ("empty_scan", "scan"),
 ])
 def test_bad_input_is_one_line_and_writes_nothing(case, msg, ball_run, cantilever_run, tmp_path, capsys):
-    from graspdef.cli import main
-
     d = tmp_path / "ball"
     shutil.copytree(ball_run, d)
     args = {"missing": [str(tmp_path / "nowhere")],
@@ -102,25 +101,39 @@ def test_bad_input_is_one_line_and_writes_nothing(case, msg, ball_run, cantileve
     (tmp_path / "empty.ply").write_text("ply\nformat ascii 1.0\ncomment units mm\nelement vertex 0\n"
                                         "property float x\nproperty float y\nproperty float z\nend_header\n")
     before = sorted(p.name for p in tmp_path.rglob("*"))
-    assert main(["report"] + args) == 2
+    assert report_main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].startswith("graspdef: error:") and msg in err[-1], err
     assert sorted(p.name for p in tmp_path.rglob("*")) == before          # nothing written
 
 
-def test_non_overlapping_scan_is_refused(ball_run, tmp_path):
-    """A scan of something else (a flat patch 10 times the ball's size) cannot be registered."""
+@pytest.mark.parametrize("case, msg", [("plane", "overlap"), ("mm_as_m", "mm")])
+def test_wrong_scan_is_refused(case, msg, ball_run, ball_scan, tmp_path):
+    """A scan of something else (a wavy patch of the ball's size) cannot be registered; a scan in
+    mm declared as metres is caught by its size.  Nothing is written."""
+    import trimesh
+
     from graspdef.geometry.io import save_ply
 
     d = tmp_path / "ball"
     shutil.copytree(ball_run, d)
-    g = np.linspace(-0.3, 0.3, 40)
-    x, y = np.meshgrid(g, g)
-    save_ply(tmp_path / "plane.ply", np.c_[x.ravel(), y.ravel(), 0.01 * np.sin(9 * x.ravel())],
-             np.zeros((0, 3), int), units="m")
-    with pytest.raises(GraspdefError):
-        build_report([d], scan=str(tmp_path / "plane.ply"))
+    if case == "plane":
+        g = np.linspace(-0.03, 0.03, 60)
+        x, y = np.meshgrid(g, g)
+        pts = np.c_[x.ravel(), y.ravel(), 0.01 * np.sin(150 * x.ravel()) * np.cos(120 * y.ravel())]
+    else:
+        pts = np.asarray(trimesh.load(ball_scan, process=False).vertices) * 1e3
+    save_ply(tmp_path / "scan.ply", pts, np.zeros((0, 3), int), units="m")
+    with pytest.raises(GraspdefError, match=msg):
+        build_report([d], scan=str(tmp_path / "scan.ply"))
     assert not (d / "report.html").exists() and not (d / "score").exists()
+
+
+def test_wired_into_graspdef_cli(capsys):
+    from graspdef.cli import main
+
+    assert main(["report", "/nonexistent/run"]) == 2
+    assert "run folder /nonexistent/run does not exist" in capsys.readouterr().err
 
 
 def test_failed_report_keeps_the_previous_one(ball_run, tmp_path):
