@@ -282,7 +282,7 @@ def _run_section(rr: RunReport, views, index: int) -> list[str]:
     out = [f"<h2 id=\"run-{index}\">{H.esc(run.label)}</h2>"]
     for n in rr.notes:
         out.append(f"<div class=\"flag\">{H.esc(n)}</div>")
-    out.append(H.table(["", ""], _summary_rows(rr), left=2, table_id=f"summary-{index}"))
+    out.append(H.table(["run", "value"], _summary_rows(rr), left=2, table_id=f"summary-{index}"))
     mag, what = rr.displacement_field()
     figs = [H.img(render_surface(run.deformed_vertices, run.faces, mag, views=views, label=f"{what} [{rr.length_label}]",
                                  title=f"{run.name}: deformed surface, {what}"),
@@ -298,7 +298,7 @@ def _run_section(rr: RunReport, views, index: int) -> list[str]:
                           alt=f"deformed surface of {run.name} coloured by scan error",
                           caption="Signed error of the nearest scan point (positive: scan outside the surface); "
                                   "grey: no scan point near (holes, unseen parts). Colour range: 99th percentile."))
-    out.append("<div class=\"grid\">" + "".join(figs) + "</div>")
+    out.append("".join(figs))
     if rr.score is not None:
         out += _score_section(rr)
     pt = run.path_table
@@ -411,14 +411,16 @@ def _table_section(rows: list[dict]) -> list[str]:
 
 def build_report(run_dirs, out: str | PathLike | None = None, *, scan: str | None = None,
                  table: str | PathLike | None = None, title: str | None = None, views=("iso", "front", "top"),
-                 surface_offset_mm: float | None = None, scan_units: str | None = None, progress=None) -> Path:
+                 surface_offset_mm: float | None = None, scan_units: str | None = None, progress=None,
+                 flagged: list | None = None) -> Path:
     """Write the report of ``run_dirs`` (and of the runs of a ``table`` file) to ``out``
     (default ``RUN_DIR/report.html`` of the first run), atomically; return its path.
 
     ``scan``: a scan file or manifest id to score every run against first (``RUN_DIR/score``).
     Raises a GraspdefError subclass (``RunFolderError``, ``ReportError``, ``RegistrationError``)
     for a missing or incomplete folder, a bad table file or a scan that cannot be registered;
-    nothing is written then."""
+    nothing is written then.  ``flagged``: a list that receives ``(run folder, flags)`` of every
+    flagged score (the page shows them too)."""
     say = progress or (lambda m: None)
     entries: list[tuple[Path, float | None, float | None]] = [(Path(d), None, None) for d in (run_dirs or [])]
     if table is not None:
@@ -439,6 +441,9 @@ def build_report(run_dirs, out: str | PathLike | None = None, *, scan: str | Non
         if measured is not None:
             rr.measured_mm = measured
         runs.append(rr)
+        if rr.score is not None and (rr.score.get("flags") or rr.score.get("ok") is False):
+            if flagged is not None:
+                flagged.append((rr.run.path, list(rr.score.get("flags") or [])))
         say(f"read {d} ({rr.run.analysis}{', scored' if rr.score else ''})")
     out_path = Path(out) if out is not None else entries[0][0] / "report.html"
     if out_path.is_dir():

@@ -25,18 +25,23 @@ def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Write the report; errors are GraspdefError subclasses (one line, exit status 2 in graspdef's
-    main)."""
+    """Write the report; 0, or 1 if a score is flagged (the page is written and says so).  Errors
+    are GraspdefError subclasses (one line, exit status 2 in graspdef's main)."""
     from .build import build_report
 
     def say(msg: str) -> None:
         if not getattr(args, "quiet", False):
             print(f"[graspdef] {msg}", file=sys.stderr, flush=True)
 
+    flagged: list = []
     out = build_report(args.run_dirs, args.out, scan=args.scan, table=args.table, title=args.title,
-                       surface_offset_mm=args.surface_offset_mm, scan_units=args.scan_units, progress=say)
+                       surface_offset_mm=args.surface_offset_mm, scan_units=args.scan_units, progress=say,
+                       flagged=flagged)
     say(f"wrote {out}")
-    return 0
+    for run_dir, flags in flagged:       # like 'graspdef score': a flagged score is exit status 1
+        print(f"graspdef: warning: the score of {run_dir} is flagged ({', '.join(flags) or 'ok = false'}); "
+              "the report shows it", file=sys.stderr)
+    return 1 if flagged else 0
 
 
 def main(argv: list[str] | None = None) -> int:

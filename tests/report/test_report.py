@@ -76,7 +76,8 @@ def test_flagged_score_is_shown(scored_report, tmp_path):
     rec = json.loads((d / "score" / "score.json").read_text())
     rec["flags"], rec["ok"] = ["prediction: not_converged"], False
     (d / "score" / "score.json").write_text(json.dumps(rec))
-    text = build_report([d]).read_text()
+    assert report_main([str(d)]) == 1                    # written, but the exit status says "flagged"
+    text = (d / "report.html").read_text()
     assert "flagged score" in text and "not_converged" in text
 
 
