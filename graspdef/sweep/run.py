@@ -9,6 +9,7 @@ Layout of a sweep folder::
     OUT/results.csv         one row per case of the spec (units in the header)
     OUT/summary.md          counts, times, the table in short, the failures with their errors
     OUT/sweep.json          the same summary, machine-readable
+    OUT/runs.jsonl          one line per invocation (cases run and reused, wall time)
 
 Resume semantics (see docs/sweep.md):
 
@@ -319,7 +320,7 @@ def _run_sweep(spec, out, scheduler, workers, retry_failed, parquet, connect_tim
         say(f"sweep {spec.name}: all {len(spec.cases)} cases already final; folder {out}")
     else:
         say(f"connecting to the dask scheduler at {scheduler}" if scheduler else
-            f"starting a local cluster: {workers} worker processes, 1 thread each")
+            f"starting a local cluster: {workers} worker process{'es' if workers != 1 else ''}, 1 thread each")
         client, cluster = _connect(scheduler, workers, connect_timeout)
         try:
             cases_dir.mkdir(parents=True, exist_ok=True)
@@ -328,7 +329,7 @@ def _run_sweep(spec, out, scheduler, workers, retry_failed, parquet, connect_tim
             write_provenance(out, prov)
             _clean_orphans(cases_dir)
             say(f"sweep {spec.name}: {len(spec.cases)} cases, {skipped} already final, {len(todo)} to run on "
-                f"{n_workers} workers ({scheduler or 'this machine'}); folder {out}")
+                f"{n_workers} worker{'s' if n_workers != 1 else ''} ({scheduler or 'this machine'}); folder {out}")
             n_run = _execute(client, todo, cases_dir, say)
         finally:
             client.close()
@@ -456,6 +457,9 @@ def write_summary(spec: SweepSpec, out: Path, rows: list[dict], seconds: float, 
                        "control_faces": list(spec.control_faces) if spec.control_faces else "shell.toml"},
               "finished_utc": _now()}
     (out / "sweep.json").write_text(json.dumps(record, indent=2) + "\n")
+    with open(out / "runs.jsonl", "a") as fh:      # one line per invocation: the history of a resumed sweep
+        fh.write(json.dumps({k: record[k] for k in ("finished_utc", "n_run", "n_skipped", "n_done", "n_failed",
+                                                    "wall_seconds")}) + "\n")
     L = [f"# Sweep {spec.name}", ""]
     if spec.description:
         L += [spec.description, ""]
@@ -470,18 +474,26 @@ def write_summary(spec: SweepSpec, out: Path, rows: list[dict], seconds: float, 
                                     + (f", gas {m['gas']}" if m["analysis"] == "nonlinear" else "")
                                     for n, m in spec.materials.items()), ""]
     L += ["| scene | force [N] | material | contact | control faces | status | max. displacement [mm] | "
-          "indentation [mm] | completed | time [s] |", "|---|---|---|---|---|---|---|---|---|---|"]
+          "indentation [mm] | path completed | time [s] |", "|---|---|---|---|---|---|---|---|---|---|"]
 
     def f(v, fmt):
         return "" if v == "" or v is None else format(float(v), fmt)
 
+    def completed(r):
+        if r["completed"] in ("", None):
+            return ""
+        if r["completed"] or r["load_factor"] in ("", None):
+            return "yes" if r["completed"] else "no"
+        return f"path stopped at {float(r['load_factor']) * r['force_N']:.3g} N"
+
     for r in rows:
         L.append(f"| {r['scene']} | {r['force_N']:g} | {r['material']} | {r['contact']} | {r['control_faces']} | "
                  f"{r['status']} | {f(r['max_displacement_mm'], '.3f')} | {f(r['indentation_mm'], '.3f')} | "
-                 f"{r['completed']} | {f(r['seconds'], '.1f')} |")
+                 f"{completed(r)} | {f(r['seconds'], '.1f')} |")
     if failed:
         L += ["", "## Failed cases", ""]
         L += [f"* `{r['case_id']}` (after {r['attempts']} attempts): {r['error']}" for r in failed]
     L += ["", "Full table: `results.csv` (one row per case, units in the column names); each case's run folder: "
-          "`cases/<case_id>/` (`graspdef view` shows it)."]
+          "`cases/<case_id>/` (`graspdef view cases/<case_id>` shows it, `graspdef report cases/<id> cases/<id> ...` "
+          "writes an HTML report of several)."]
     (out / "summary.md").write_text("\n".join(L) + "\n")

@@ -80,6 +80,9 @@ def test_killed_worker_loses_no_finished_case(tmp_path):
         case_id, pid = killed[0]
         rec = json.loads((out / CASES / case_id / "case.json").read_text())
         assert rec["status"] == "done" and rec["worker"]["pid"] != pid
+        prov = json.loads((out / CASES / case_id / "provenance.json").read_text())
+        assert prov["config"]["case"]["id"] == case_id and prov["packages"]["mujoco"]
+        assert json.loads((out / "provenance.json").read_text())["config"]["text"] == spec.text
         assert not [p for p in (out / CASES).iterdir() if p.name.startswith(".") and p.name != RUNNING]
         # the failing case: retried once, then recorded with its error
         failed = json.loads((out / CASES / bad.id / "case.json").read_text())
