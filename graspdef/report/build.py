@@ -69,6 +69,20 @@ class RunReport:
         return "force_N" in self.run.record
 
     @property
+    def obj(self) -> str | None:
+        """The grasped object's name (grasp runs), else None."""
+        o = self.run.record.get("object")
+        return None if o is None else str(o)
+
+    def stopped_at(self) -> float | None:
+        """The load factor where an incomplete nonlinear path stopped, else None."""
+        rec = self.run.record
+        conv = rec.get("convergence") if isinstance(rec.get("convergence"), dict) else rec
+        if self.run.analysis == "nonlinear" and conv.get("completed") is False:
+            return float(conv.get("load_factor", float("nan")))
+        return None
+
+    @property
     def length_label(self) -> str:
         return "consistent units" if self.run.length_unit == "consistent" else "mm"
 
@@ -110,9 +124,10 @@ def rigid_fit_residual(x: np.ndarray, u: np.ndarray) -> np.ndarray:
     return u - (A @ coef).reshape(-1, 3)
 
 
-def paper_row(force_N: float | None) -> dict | None:
-    """The paper's Table I row of this force (within 0.05 N), or None."""
-    if force_N is None:
+def paper_row(force_N: float | None, obj: str | None = None) -> dict | None:
+    """The paper's Table I row of this force (within 0.05 N), or None; only for the tennis ball
+    (``obj``: the grasp run's object; None = unknown, e.g. a solve run listed in a table file)."""
+    if force_N is None or (obj is not None and "tennis" not in str(obj).lower()):
         return None
     for row in PAPER_TABLE_I:
         if abs(row["force_N"] - force_N) <= FORCE_MATCH_N:
@@ -137,7 +152,7 @@ def load_run(run_dir: str | PathLike, score_dir: str | PathLike | None = None) -
     """Read a run folder (and its score, if any) for the report."""
     run = read_run(run_dir, score_dir)
     rr = RunReport(run, force_N=run.record.get("force_N"))
-    row = paper_row(rr.force_N)
+    row = paper_row(rr.force_N, rr.obj)
     rr.measured_mm = row["measured_max_mm"] if row else None
     if run.scan is not None:
         rr.score_dir = run.scan.source
@@ -347,7 +362,7 @@ def table_rows(runs: list[RunReport]) -> list[dict]:
             continue
         key = round(float(rr.force_N), 2)
         row = by_force.setdefault(key, {"force_N": float(rr.force_N), "measured_mm": rr.measured_mm,
-                                        "paper": paper_row(rr.force_N)})
+                                        "paper": paper_row(rr.force_N, rr.obj)})
         if row["measured_mm"] is None:
             row["measured_mm"] = rr.measured_mm
         kind = "linear" if rr.run.analysis == "linear" else "nonlinear"
@@ -355,13 +370,13 @@ def table_rows(runs: list[RunReport]) -> list[dict]:
             row.setdefault("extra", []).append(rr)
             continue
         md = rr.max_displacement()
-        ent = {"run": rr, "max_mm": md, "scan_mean_mm": None, "flagged": False}
+        ent = {"run": rr, "max_mm": md, "scan_mean_mm": None, "flagged": False, "stopped_at": rr.stopped_at()}
         if rr.score is not None:
             ent["scan_mean_mm"] = rr.score["prediction"]["errors"].get("mean_mm")
             ent["flagged"] = not rr.score.get("ok", True)
         if ent["scan_mean_mm"] is not None:
             ent["error_mm"], ent["error_kind"] = ent["scan_mean_mm"], "shape"
-        elif md is not None and row["measured_mm"] is not None:
+        elif md is not None and row["measured_mm"] is not None and ent["stopped_at"] is None:
             ent["error_mm"], ent["error_kind"] = abs(md - row["measured_mm"]), "max"
         else:
             ent["error_mm"], ent["error_kind"] = None, None
@@ -378,7 +393,11 @@ def _table_section(rows: list[dict]) -> list[str]:
         return f"{ent['error_mm']:.3g} <small>({tag})</small>{flag}"
 
     def mx(ent):
-        return "&ndash;" if not ent or ent.get("max_mm") is None else f"{ent['max_mm']:.3g}"
+        if not ent or ent.get("max_mm") is None:
+            return "&ndash;"
+        if ent.get("stopped_at") is not None:      # not the prediction at this force
+            return f"{ent['max_mm']:.3g} <small>(path stopped at load factor {ent['stopped_at']:.3g})</small>"
+        return f"{ent['max_mm']:.3g}"
 
     body = []
     for r in rows:
@@ -395,7 +414,8 @@ def _table_section(rows: list[dict]) -> list[str]:
            "others. Errors: <b>shape</b> = mean scan-to-surface distance after registration (the paper's "
            "&ldquo;average shape error&rdquo;), when the run has a score; otherwise <b>&Delta;max</b> = |predicted "
            "&minus; measured| maximum displacement (not the paper's measure). &#9888;: the score is flagged. "
-           "Predicted maximum displacement: result.json (grasp runs: rigid motion removed).</p>"]
+           "Predicted maximum displacement: result.json (grasp runs: rigid motion removed); a path that stopped "
+           "before the full force is marked and gets no error.</p>"]
     forces = [f"{r['force_N']:.2f} N" for r in rows]
     series = {"measured": [r["measured_mm"] if r["measured_mm"] is not None else np.nan for r in rows]}
     for kind in ("nonlinear", "linear"):
@@ -436,7 +456,7 @@ def build_report(run_dirs, out: str | PathLike | None = None, *, scan: str | Non
         rr = load_run(d, score_dir)
         if force is not None:
             rr.force_N = force
-            row = paper_row(force)
+            row = paper_row(force, rr.obj)
             rr.measured_mm = row["measured_max_mm"] if row else None
         if measured is not None:
             rr.measured_mm = measured
@@ -454,9 +474,10 @@ def build_report(run_dirs, out: str | PathLike | None = None, *, scan: str | Non
                       + (f" and {len(runs) - 4} more" if len(runs) > 4 else ""))
     body = ["<p class=\"note\">Contents: " + ", ".join(
         f"<a href=\"#run-{i}\">{H.esc(rr.run.label)}</a>" for i, rr in enumerate(runs))
-        + (", <a href=\"#table-i\">Table I</a>" if any(rr.force_N is not None for rr in runs) else "") + "</p>"]
+        + "</p>"]
     rows = table_rows(runs)
-    if rows:
+    if any(r["measured_mm"] is not None or ("nonlinear" in r and "linear" in r) for r in rows) or len(rows) > 1:
+        body[0] = body[0].replace("</p>", ", <a href=\"#table-i\">Table I</a></p>")
         body += _table_section(rows)
     for i, rr in enumerate(runs):
         say(f"rendering {rr.run.name}")

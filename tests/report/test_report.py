@@ -149,3 +149,26 @@ def test_failed_report_keeps_the_previous_one(ball_run, tmp_path):
     assert sorted(p.name for p in d.iterdir() if p.name.startswith(".report-")) == []
     with pytest.raises(ReportError, match="no run folders"):
         build_report([])
+
+
+def test_paper_values_only_for_the_tennis_ball_forces():
+    from graspdef.report.build import paper_row
+
+    assert paper_row(10.63, "tennis_ball")["measured_max_mm"] == 2.56
+    assert paper_row(21.47, None)["measured_max_mm"] == 10.27           # within 0.05 N
+    assert paper_row(10.63, "duck") is None
+    assert paper_row(10.75, "tennis_ball") is None and paper_row(None) is None
+
+
+def test_a_stopped_path_is_marked_and_gets_no_error(cantilever_run, tmp_path):
+    d = tmp_path / "stopped"
+    shutil.copytree(cantilever_run, d)
+    rec = json.loads((d / "result.json").read_text())
+    rec.update(completed=False, stop_reason="Newton did not converge (test)", load_factor=0.5)
+    (d / "result.json").write_text(json.dumps(rec))
+    (tmp_path / "runs.csv").write_text("run,force_N\nstopped,10.63\n")
+    text = build_report([], tmp_path / "r.html", table=tmp_path / "runs.csv").read_text()
+    row = re.findall(r"<tr>(<td.*?)</tr>", text[text.index('id="table-i-table"'):])[0]
+    cells = re.findall(r"<td[^>]*>(.*?)</td>", row)
+    assert "path stopped at load factor 0.5" in cells[2] and cells[3] == "&ndash;"
+    assert "Newton did not converge (test)" in text and "the load path stopped" in text
