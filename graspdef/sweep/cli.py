@@ -9,7 +9,26 @@ from typing import Callable
 from ..errors import ProblemError
 
 
+EPILOG = """examples:
+  graspdef sweep sweeps/smoke.toml --out out/sweep_smoke        # embedded local cluster, 2 worker processes
+  graspdef sweep out/sweep_smoke                                # resume: finished and failed cases are kept
+  graspdef sweep sweeps/table1.toml --out /shared/t1 --scheduler tcp://head:8786
+
+a spec (docs/sweep.md):
+  [grid]
+  scenes = ["tennis_ball"]
+  forces_N = [10.63, 21.48]
+  materials = ["linear", "rubber_air"]      # built-in: linear, nonlinear
+  control_faces = [320, 1280]               # optional mesh levels
+  [materials.rubber_air]
+  analysis = "nonlinear"
+  gas = "on"
+"""
+
+
 def add_arguments(ap: argparse.ArgumentParser) -> None:
+    ap.epilog = EPILOG
+    ap.formatter_class = argparse.RawDescriptionHelpFormatter
     ap.add_argument("spec", help="sweep spec (.toml), or an existing sweep folder to resume (its spec.toml)")
     ap.add_argument("--out", help="sweep folder (created, or resumed: finished cases are not recomputed); "
                                   "default: the folder given as SPEC")
