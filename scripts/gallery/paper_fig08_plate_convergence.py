@@ -46,16 +46,11 @@ def plate(n: int) -> tuple[int, float]:
 
 
 def main(argv: list[str] | None = None) -> dict:
-    a = C.parse(NAME, __doc__, argv)
-    clock = C.Timer()
-    rows = C.run_study("plate_ss_uniform", plate, PLATE_REF, FAST_SIZES if a.fast else SIZES)
-    fig, key = C.convergence_figure("plate_ss_uniform", rows, PLATE_REF, f"Navier series {PLATE_REF:.5f}", "value",
-                                    "centre deflection", "Fig. 8: simply supported plate, uniform load")
-    key["published"] = "0.443 (analytical); paper's solver ~1?% below (digit illegible)"
-    print(C.table([key], ["study", "n_control", "graspdef", "reference", "error_%", "published"]))
-    rec = {"figure": "Tian & Jia 2010, Fig. 8", "fast": a.fast, "rows": rows, "key": key,
-           "reference_source": "Navier series, ../shared/BENCHMARKS.md 2.1-2.2", "seconds": clock()}
-    return C.finish(a.out, NAME, rec, fig, rows)
+    return C.convergence_main(
+        NAME, __doc__, argv, "plate_ss_uniform", plate, PLATE_REF, SIZES, FAST_SIZES,
+        dict(ref_label=f"Navier series {PLATE_REF:.5f}", column="value", ylabel="centre deflection",
+             title="Fig. 8: simply supported plate, uniform load"),
+        "0.443 (analytical); paper's solver ~1?% below (digit illegible)", "Navier series, ../shared/BENCHMARKS.md 2.1-2.2")
 
 
 if __name__ == "__main__":

@@ -56,20 +56,12 @@ def pinched_cylinder(n_z: int) -> tuple[int, float]:
 
 
 def main(argv: list[str] | None = None) -> dict:
-    a = C.parse(NAME, __doc__, argv)
-    clock = C.Timer()
-    rows = C.run_study("pinched_cylinder", pinched_cylinder, CYL_REF, FAST_SIZES if a.fast else SIZES)
-    for r in rows:
-        r["normalised"] = r["value"] / CYL_REF
-    fig, key = C.convergence_figure("pinched_cylinder", rows, CYL_REF, "reference 1.8248e-5", "normalised",
-                                    "normalised displacement under the load", "Fig. 11: pinched cylinder",
-                                    ratio=True)
-    key["normalised"] = rows[-1]["normalised"]
-    key["published"] = "paper: normalised value approaching 1 at <= 2,500 control points (curve only)"
-    print(C.table([key], ["study", "n_control", "graspdef", "reference", "error_%", "order_three_coarsest"]))
-    rec = {"figure": "Tian & Jia 2010, Fig. 11", "fast": a.fast, "rows": rows, "key": key,
-           "reference_source": "MacNeal & Harder 1985 via ../shared/BENCHMARKS.md 1.2", "seconds": clock()}
-    return C.finish(a.out, NAME, rec, fig, rows)
+    return C.convergence_main(
+        NAME, __doc__, argv, "pinched_cylinder", pinched_cylinder, CYL_REF, SIZES, FAST_SIZES,
+        dict(ref_label="reference 1.8248e-5", column="normalised", ylabel="normalised displacement under the load",
+             title="Fig. 11: pinched cylinder"),
+        "paper: normalised value approaching 1 at <= 2,500 control points (curve only)",
+        "MacNeal & Harder 1985 via ../shared/BENCHMARKS.md 1.2", ratio=True)
 
 
 if __name__ == "__main__":
