@@ -179,7 +179,8 @@ def predictions(subdivisions: int, levels, n_ring: int = N_RING) -> dict:
 
     out = {"n_control": int(shell.mesh.n_real), "seconds_linear": t_lin, "seconds_nonlinear": t_nl,
            "newton_iterations": int(sum(nl.iterations())), "undeformed": surf(np.zeros_like(X)),
-           "linear": [], "nonlinear": [], "apex_linear_m": [], "apex_nonlinear_m": []}
+           "linear": [], "nonlinear": [], "apex_linear_m": [], "apex_nonlinear_m": [], "factors": factors,
+           "path": [(p.load_factor, p.iterations, np.asarray(p.probes["top"]) * R_M) for p in nl.path]}
     for f in factors:
         pt = nl.at(f)
         out["nonlinear"].append(surf(pt.u))
@@ -193,10 +194,13 @@ def predictions(subdivisions: int, levels, n_ring: int = N_RING) -> dict:
 # scans and scores
 # --------------------------------------------------------------------------------------------
 def run(subdivisions=(3, 4), forces=FORCES_N, n_points: int = 30_000, seed: int = 0,
-        reference_subdivisions: int = 6, n_target: int = 60_000, n_ring: int = N_RING, progress=print) -> dict:
+        reference_subdivisions: int = 6, n_target: int = 60_000, n_ring: int = N_RING, runs_dir=None,
+        progress=print) -> dict:
     """The study (see the module docstring); returns the record written to study.json.  ``n_target``:
     points sampled on each surface for the ICP (graspdef.registration.register); ``n_ring``: point
-    loads per ring on the 3-D shell."""
+    loads per ring on the 3-D shell.  ``runs_dir``: also write every prediction as a run folder,
+    score it with ``graspdef score`` (score_cli) and write ``report_<n>.html`` (graspdef report)
+    with the Table I layout there."""
     from graspdef.registration import score
     from graspdef.scans import Scanner, scan_surface
 
@@ -236,6 +240,9 @@ def run(subdivisions=(3, 4), forces=FORCES_N, n_points: int = 30_000, seed: int 
                             f"{name}_max_mm": st["max"] * MM, f"{name}_p95_mm": st["p95"] * MM})
             row["flags"] = sorted(set(res_nl["flags"] + [f.replace("prediction", "linear") for f in res_li["flags"]]))
             rows.append(row)
+        if runs_dir is not None:
+            page = write_runs(Path(runs_dir), pred, scans, forces, merid)
+            progress(f"  run folders, scores and the report: {page}")
             progress(f"  {F:6.2f} N: RMS nonlinear {row['nonlinear_rms_mm']:.3f} mm, linear {row['linear_rms_mm']:.3f} mm, "
                      f"undeformed {row['undeformed_rms_mm']:.3f} mm; max {row['nonlinear_max_mm']:.3f} / "
                      f"{row['linear_max_mm']:.3f} / {row['undeformed_max_mm']:.3f} mm"
@@ -257,6 +264,61 @@ def run(subdivisions=(3, 4), forces=FORCES_N, n_points: int = 30_000, seed: int 
                     "seeds": [seed + i for i in range(len(forces))]},
         "meshes": meshes, "rows": rows, "checks": checks,
     }
+
+
+def write_runs(root: Path, pred: dict, scans, forces, merid) -> Path:
+    """Each prediction as a run folder (result.json, deformed.ply, undeformed.ply [m]; path.csv
+    for the nonlinear ones), scored with ``graspdef score`` against the scan of its force
+    (``<run>/score``), and ``graspdef report --table`` over them (``report_<n>.html``): the study
+    in the layout of Table I, the reference's apex displacement as the "measured" value."""
+    import csv as _csv
+
+    from graspdef.geometry.io import atomic_folder, save_ply
+    from graspdef.registration import score_cli
+    from graspdef.report import build_report
+    from graspdef.scans import write_scan
+
+    n = pred["n_control"]
+    und = pred["undeformed"]
+    table = []
+    for i, F in enumerate(forces):
+        scan_path = root / "scans" / f"scan_{F:.2f}N.ply"
+        if not scan_path.is_file():
+            write_scan(scans[i], scan_path, units="m")
+        for kind in ("nonlinear", "linear"):
+            surf = pred[kind][i]
+            d = root / f"{kind}_{n}_{F:.2f}N"
+            u = surf.vertices - und.vertices
+            apex = -pred[f"apex_{kind}_m"][i]
+            rec = {"name": d.name, "units": {"length": "m", "force": "N"}, "analysis": kind,
+                   "description": f"3-D shell ({n} control vertices), sphere pinched by rings of {F} N "
+                                  "(scripts/synthetic_scan_study.py)",
+                   "max_displacement": float(np.linalg.norm(u, axis=1).max()),
+                   "probes": {"apex": {"displacement": [0.0, 0.0, -apex]}},
+                   "files": {"deformed": "deformed.ply"}}
+            f = pred["factors"][i]
+            pts = [p for p in pred["path"] if p[0] <= f * (1 + 1e-9)]
+            if kind == "nonlinear":
+                rec.update(completed=True, load_factor=f, newton_iterations=[p[1] for p in pts[1:]])
+            with atomic_folder(d) as tmp:
+                (tmp / "result.json").write_text(json.dumps(rec, indent=2) + "\n")
+                save_ply(tmp / "deformed.ply", surf.vertices, surf.faces, units="m")
+                save_ply(tmp / "undeformed.ply", und.vertices, und.faces, units="m")
+                if kind == "nonlinear":
+                    with (tmp / "path.csv").open("w", newline="") as fh:
+                        w = _csv.writer(fh)
+                        w.writerow(["point", "load_factor", "newton_iterations", "top_ux[m]", "top_uy[m]", "top_uz[m]"])
+                        for k, (lf, its, top) in enumerate(pts):
+                            w.writerow([k, lf, its, *top])
+            score_cli(d / "deformed.ply", scan_path, d / "score")
+            table.append((d.name, F, -merid[i]["apex_m"] * MM))
+    csv_path = root / f"table_{n}.csv"
+    with csv_path.open("w", newline="") as fh:
+        w = _csv.writer(fh)
+        w.writerow(["run", "force_N", "measured_mm"])
+        w.writerows(table)
+    return build_report([], root / f"report_{n}.html", table=csv_path,
+                        title=f"Synthetic-scan study: axisymmetric reference vs 3-D shell ({n} control vertices)")
 
 
 def write(result: dict, out: Path) -> None:
@@ -305,11 +367,14 @@ def main(argv=None) -> int:
     ap.add_argument("--points", type=int, help="scan points (30000; --fast 10000)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default="out/synthetic_scan_study")
+    ap.add_argument("--runs", action="store_true", help="also write run folders, their scores and a "
+                                                        "'graspdef report' page (OUT/runs/report_<n>.html)")
     a = ap.parse_args(argv)
     subs = a.subdivisions or ([2] if a.fast else [3, 4])
     pts = a.points or (10_000 if a.fast else 30_000)
     t0 = time.perf_counter()
     res = run(subs, n_points=pts, seed=a.seed, reference_subdivisions=5 if a.fast else 6,
+              runs_dir=Path(a.out) / "runs" if a.runs else None,
               progress=lambda m: print(m, file=sys.stderr, flush=True))
     res["seconds"] = time.perf_counter() - t0
     write(res, Path(a.out))
