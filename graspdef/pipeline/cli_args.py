@@ -8,7 +8,8 @@ def add_grasp_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("scene", help="scene.xml, its folder, or a name under scenes/ (e.g. tennis_ball)")
     ap.add_argument("--force", type=float, required=True, help="squeezing force per finger [N]")
     ap.add_argument("--contact", choices=["point", "geometric"], default="point",
-                    help="point loads (the paper's model); 'geometric' is not implemented yet")
+                    help="point loads (the paper's model) or geometric: the fingertips as rigid, force-controlled, "
+                         "penetration-free obstacles (contact area grows with the load)")
     ap.add_argument("--analysis", choices=["linear", "nonlinear"], default="nonlinear")
     ap.add_argument("--gas", choices=["auto", "on", "off"], default="auto",
                     help="enclosed air: auto = shell.toml's (nonlinear only), on (80 kPa if none given), off")

@@ -148,8 +148,9 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     ``gas``: None = as shell.toml says; False/True forces the enclosed air off/on (80 kPa gauge
     when shell.toml has none).  ``E`` [Pa]: overrides shell.toml's Young's modulus."""
     t0 = time.perf_counter()
-    if contact != "point":
-        raise ProblemError(f"contact model {contact!r} is not implemented (only 'point': the paper's point loads)")
+    if contact not in ("point", "geometric"):
+        raise ProblemError(f"contact must be 'point' (the paper's point loads) or 'geometric' (rigid fingertips), "
+                           f"got {contact!r}")
     if analysis not in ("linear", "nonlinear"):
         raise ProblemError(f"analysis must be 'linear' or 'nonlinear', got {analysis!r}")
     if not np.isfinite(force) or force <= 0:
@@ -175,6 +176,12 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     cs = g.contacts.transformed(g.pose)
     mapping = map_contacts(shell, cs)
     loads = list(mapping.loads)
+    fingertips = []
+    if contact == "geometric":      # fingertips as rigid obstacles; MuJoCo's other force parts stay dead loads
+        from .geometric import finger_contacts
+
+        loads, fingertips = finger_contacts(mapping, g, targets, spec.thickness)
+        loads = loads + fingertips
     g_obj = g.pose.vector_to_object(g.gravity)
     free = bool(g.info.get("free_object", True))
     if free:
@@ -205,26 +212,34 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     residual_F = fvec.sum(axis=0)
     residual_M = np.cross(shell.rest_positions, fvec).sum(axis=0)
     completed, stop_reason = True, None
-    if analysis == "linear":
-        if p0 > 0:
-            raise ProblemError("an enclosed gas needs the nonlinear analysis (p V = const is nonlinear)")
+    opt = PathOptions(steps=steps or spec.steps, max_steps=40 * (steps or spec.steps), min_step=1e-3)
+    if analysis == "linear" and p0 > 0:
+        raise ProblemError("an enclosed gas needs the nonlinear analysis (p V = const is nonlinear)")
+    if analysis == "linear" and not fingertips:
         sol = solve_linear(problem)
     else:
-        opt = PathOptions(steps=steps or spec.steps, max_steps=40 * (steps or spec.steps), min_step=1e-3)
+        from .geometric import solve_contact
+
         try:
-            sol = solve_nonlinear(problem, opt)
+            sol = solve_contact(problem, opt, linear=analysis == "linear") if fingertips else solve_nonlinear(problem, opt)
         except PathStopped as exc:
             sol, completed, stop_reason = exc.solution, False, str(exc)
     t_solve = time.perf_counter()
     # displacements and indentation (rigid-motion free)
     Lm = sol.limit_map()
     x_lim = Lm @ shell.mesh.vertices
-    u_lim = sol.vertex_displacements()
+    # displacements from the unloaded equilibrium (load factor 0: the shell inflated by its air,
+    # which is the state the scan and MuJoCo's rigid proxy show), not from the stress-free shape
+    ref = sol.path[0] if hasattr(sol, "path") else None
+    u_lim = sol.vertex_displacements() - (Lm @ ref.u if ref is not None else 0.0)
     u_def = _rigid_fit_residual(x_lim, u_lim) if free else u_lim
     fingers = {}
     pf = g.per_finger()
+    def probe(s):
+        return sol.probe(s) - (np.asarray(ref.probes[s]) if ref is not None else 0.0)
+
     for s, sp in probes.items():
-        u = sol.probe(s)
+        u = probe(s)
         n = pf[s]["normal"]
         fingers[s] = {"target_N": targets[s], "normal_force_N": pf[s]["normal_force"],
                       "axial_force_N": g.info["axial_force_N"][s],
@@ -236,7 +251,7 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
         e = g.pose.vector_to_object(pf["right"]["point"] - pf["left"]["point"])
         sep = float(np.linalg.norm(e))
         e /= sep
-        approach = float((sol.probe("left") - sol.probe("right")) @ e)
+        approach = float((probe("left") - probe("right")) @ e)
         feedback = {"rigid_contact_separation_m": sep, "approach_m": approach,
                     "indentation_per_finger_m": approach / 2,
                     "mujoco_tip_gap_m": g.tip_gap, "predicted_tip_gap_m": g.tip_gap - approach,
@@ -247,6 +262,27 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
         s = next(iter(probes))
         ind = fingers[s]["displacement_along_normal_m"]      # along the push: positive = indented
         feedback = {"indentation_m": ind, "mujoco_tip_gap_m": g.tip_gap, "mismatch_m": ind}
+    geo = None
+    if fingertips:
+        from .geometric import contact_reports
+
+        lam = getattr(sol, "load_factor", 1.0)
+        geo = contact_reports(shell, fingertips, sol.u, lam, None if ref is None else ref.u)
+        for s, r in geo.items():
+            fingers[s].update({"advance_m": r["advance_m"], "contact_area_m2": r["contact_area_m2"],
+                               "contact_force_N": r.get("contact_force_N"),
+                               "contact_force_along_axis_N": r.get("contact_force_along_axis_N"),
+                               "peak_pressure_Pa": r.get("peak_pressure_Pa")})
+        adv = [r["advance_m"] - r["touch_advance_m"] for r in geo.values()]
+        key = "indentation_per_finger_m" if len(adv) == 2 else "indentation_m"
+        feedback.update({"probe_approach_m": feedback.get("approach_m"), "approach_m": float(sum(adv)),
+                         key: float(sum(adv)) / len(adv), "predicted_tip_gap_m": g.tip_gap - float(sum(adv)),
+                         "mismatch_m": float(sum(adv)),
+                         "note": "geometric contact: the approach is the fingers' travel from where they touch the "
+                                 "unloaded shell (advance of each force-controlled fingertip)"})
+        # net force of everything acting on the shell (dead loads + contact forces): what the
+        # 3-2-1 support carries
+        residual_F = residual_F + sum(np.asarray(r.get("contact_force_N", np.zeros(3))) for r in geo.values())
     rec = {
         "scene": str(xml), "object": spec.body, "force_N": force, "contact": contact, "analysis": analysis,
         "material": {"model": "linear_elastic" if analysis == "linear" else "neo_hookean", "E_Pa": spec.E,
@@ -255,22 +291,32 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
         "max_displacement_m": float(np.linalg.norm(u_def, axis=1).max()),
         "max_displacement_raw_m": float(np.linalg.norm(u_lim, axis=1).max()),
         "fingers": fingers, "feedback": feedback,
-        "contact_area_m2": 0.0,
+        "displacement_reference": "unloaded equilibrium (load factor 0; with air: the inflated shell)",
+        "contact_area_m2": float(sum(r["contact_area_m2"] for r in geo.values())) if geo else 0.0,
         "load_mapping": mapping.record(),
-        "residual": {"net_force_N": np.asarray(residual_F).tolist(), "net_moment_Nm": np.asarray(residual_M).tolist()},
+        "residual": {"net_force_N": np.asarray(residual_F).tolist(),
+                     "net_moment_Nm": None if geo else np.asarray(residual_M).tolist()},
         "mujoco": g.record(),
         "convergence": {"completed": completed, "stop_reason": stop_reason},
         "timings_s": {"shell_setup": t_shell - t_setup, "mujoco": t_sim - t_shell, "solve": t_solve - t_sim,
                       "total": time.perf_counter() - t0},
         "units": "SI (m, N, Pa)",
     }
-    if analysis == "nonlinear":
+    if geo:
+        rec["geometric_contact"] = {
+            "model": "rigid force-controlled fingertips, IPC log barrier on mid-surface samples against the "
+                     "fingertip inflated by t/2", "fingers": geo,
+            "contact_area_definition": "sampled surface area with gap < dhat (contact pressure > 0)",
+            "friction": "MuJoCo's contact forces less their finger-axis parts, as dead loads at the contacts"}
+    if hasattr(sol, "path"):
         rec["convergence"].update({"load_factor": sol.load_factor, "n_points": len(sol.path),
                                    "newton_iterations": sol.iterations(), "n_factorisations": sol.n_factorisations,
                                    "critical_points": [dict(cp, probes={k: np.asarray(v).tolist() for k, v in cp["probes"].items()})
                                                        for cp in sol.critical_points]})
     else:
         rec["convergence"].update({"relative_residual": sol.kkt.residual})
+    if analysis == "linear" and fingertips:
+        rec["convergence"]["note"] = "linear shell (rest stiffness K0) with contact: a load path of the nonlinear solver"
     if out is not None:
         out = Path(out)
         _write(out, rec, g, sol, x_lim, u_def)
@@ -322,8 +368,10 @@ def run_from_args(a) -> int:
     fb = r["feedback"]
     ind = fb.get("indentation_per_finger_m", fb.get("indentation_m", 0.0))
     stop = "" if r["convergence"]["completed"] else f" (path stopped at load factor {r['convergence'].get('load_factor', 0):.3g})"
-    print(f"{r['object']}: {r['analysis']} shell, point loads, {r['force_N']:g} N per finger: indentation "
-          f"{ind * 1e3:.2f} mm per finger, max displacement {r['max_displacement_m'] * 1e3:.2f} mm{stop}; "
+    model = "point loads" if r["contact"] == "point" else "geometric contact"
+    area = f", contact area {r['contact_area_m2'] * 1e6:.1f} mm^2" if r["contact"] == "geometric" else ""
+    print(f"{r['object']}: {r['analysis']} shell, {model}, {r['force_N']:g} N per finger: indentation "
+          f"{ind * 1e3:.2f} mm per finger, max displacement {r['max_displacement_m'] * 1e3:.2f} mm{area}{stop}; "
           f"{r['timings_s']['total']:.1f} s")
     print(f"run folder: {run.out}")
     return 0

@@ -258,4 +258,7 @@ Potential = FollowerPressure | EnclosedGas | EdgeMoment
 
 
 def is_potential(load) -> bool:
-    return isinstance(load, (FollowerPressure, EnclosedGas, EdgeMoment))
+    """The three potentials above, or any object with their interface (bind, scaled, evaluate,
+    load, commit), e.g. a contact potential of a higher layer (graspdef.contact.FingerContact)."""
+    return isinstance(load, (FollowerPressure, EnclosedGas, EdgeMoment)) or all(
+        callable(getattr(load, m, None)) for m in ("bind", "scaled", "evaluate", "load", "commit"))

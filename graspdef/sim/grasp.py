@@ -125,6 +125,22 @@ def _contacts(sc: Scene, active: dict) -> ContactSet:
                       tuple(geoms), np.array(trq))
 
 
+def _fingertip(sc: Scene, side: str, body: int, axis: np.ndarray) -> dict:
+    """The fingertip geom of ``side`` at the current state (world frame): MuJoCo type name,
+    size, position, rotation (columns = geom axes) and the finger's closing axis (unit)."""
+    mj = mujoco()
+    m, d = sc.model, sc.data
+    for name in (f"{side}_pin", f"{side}_pad"):
+        gid = mj.mj_name2id(m, mj.mjtObj.mjOBJ_GEOM, name)
+        if gid >= 0:
+            break
+    else:
+        raise SimError(f"{sc.path}: no fingertip geom '{side}_pin' or '{side}_pad'")
+    return {"geom": name, "type": mj.mjtGeom(int(m.geom_type[gid])).name.removeprefix("mjGEOM_").lower(),
+            "size": m.geom_size[gid].tolist(), "position": d.geom_xpos[gid].tolist(),
+            "rotation": d.geom_xmat[gid].reshape(3, 3).tolist(), "axis": (axis / np.linalg.norm(axis)).tolist()}
+
+
 def _speed(sc: Scene) -> float:
     d, m = sc.data, sc.model
     v = [abs(d.qvel[sc.fingers[s][2]]) for s in SIDES]
@@ -218,12 +234,14 @@ def grasp(scene, force: float | dict, object: str, settings: GraspSettings = Gra
                        f"'{object}' slipped out of the grasp")
     pf = cs.per_finger()
     axial = {}
+    tips = {}
     for s in active:
         # the closing axis of the finger in the world (its slide joint's axis)
         b, _qa, da, _a = sc.fingers[s]
         j = [jj for jj in range(m.njnt) if m.jnt_bodyid[jj] == b][0]
         axis = d.xmat[b].reshape(3, 3) @ m.jnt_axis[j]
         axial[s] = float(pf[s]["force"] @ axis)
+        tips[s] = _fingertip(sc, s, b, axis)
         err = (axial[s] - targets[s]) / targets[s]
         if abs(err) > settings.force_rtol_error:
             raise SimError(f"{sc.path}: {s} finger presses {axial[s]:.4g} N along its axis, target {targets[s]:.4g} N "
@@ -232,7 +250,7 @@ def grasp(scene, force: float | dict, object: str, settings: GraspSettings = Gra
     res = GraspResult(str(sc.path), object, targets, cs, sc.body_pose(), sc.tip_gap(), float(d.time),
                       time.perf_counter() - t_wall, settled, float(speed), mass, gravity,
                       {"axial_force_N": axial, "t_contact_s": t_contact, "t_release_s": t_release, "timestep_s": float(dt),
-                       "free_object": sc.free})
+                       "free_object": sc.free, "fingertips": tips})
     if not settled:
         log.warning("%s: not settled after %.2f s (max speed %.2e m/s)", sc.path, settings.max_settle_time, speed)
     return res

@@ -137,7 +137,9 @@ class Equilibrium:
             S = np.diag(1.0 / c) + V.T @ W                                    # C^-1 + V^T A^-1 V
             self._lowrank = (V, W, S)
             if neg is not None:
-                neg = neg + int((np.linalg.eigvalsh(-S) < 0).sum()) - len(c)
+                # Haynsworth: neg(A + V C V^T) = neg(A) + neg(-S) - neg(-C^-1); negative c
+                # (e.g. a force-controlled contact's condensed DOF) adds no negative pivot
+                neg = neg + int((np.linalg.eigvalsh(-S) < 0).sum()) - int((c > 0).sum())
         return None if neg is None else neg - self.m
 
     def solve(self, rhs: np.ndarray, g: np.ndarray | None = None) -> np.ndarray:

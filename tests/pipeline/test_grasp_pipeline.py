@@ -34,7 +34,10 @@ def test_bad_input_leaves_nothing(tmp_path, capsys):
     assert "beyond what the actuator" in capsys.readouterr().err
     assert not out.exists()
     assert grasp_cli(["no_such_scene", "--force", "5", "--out", str(out)]) == 2
-    assert grasp_cli(["tennis_ball", "--force", "5", "--contact", "geometric", "--out", str(out)]) == 2
+    assert grasp_cli(["tennis_ball", "--force", "nan", "--contact", "geometric", "--out", str(out)]) == 2
+    assert "positive number of newtons" in capsys.readouterr().err
+    with pytest.raises(GraspdefError, match="contact must be"):
+        run_grasp("tennis_ball", 5.0, "pressure", "linear", out)
     assert not out.exists() and not list(tmp_path.glob(".bad*"))
     with pytest.raises(GraspdefError, match="no shell.toml"):
         run_grasp("test_sphere", 5.0, "point", "linear", None)

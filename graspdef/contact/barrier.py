@@ -1,0 +1,501 @@
+"""Geometric contact: a rigid fingertip pressed onto the shell with a given force, penetration-free.
+
+The fingertip is an analytic rigid obstacle in the object frame (:class:`Capsule` for a pin,
+:class:`RoundedBox` for a pad), taken from the MuJoCo scene at equilibrium.  It may translate
+along its finger's closing axis ``e`` (the slide joint); everything else about it is fixed.
+
+**Gap.**  Samples of the shell's *mid*-surface limit surface, p_k = sum_i N_i(k) x_i, are kept out of
+the obstacle *inflated by t/2*: d_k = phi(p_k - s e) - t/2, with phi the obstacle's distance
+function and s its advance along e.  Where the shell touches the obstacle its normal is the
+obstacle's normal, and there the gap of the outer skin (p + t/2 n) to the obstacle equals d_k;
+elsewhere the two differ by O(t/2 * angle^2), inside the barrier's reach d_hat only where the
+surfaces are nearly parallel anyway.  Inflating the obstacle keeps p_k linear in the control
+points (no normal derivatives), so the barrier's Hessian is exact and cheap.
+
+**Samples.**  The faces within the obstacle's reach (laterally, about its axis) are cut into
+L x L sub-triangles of their parameter domain, sampled at the sub-triangle centroids with weight
+|a1 x a2| / (2 L^2) (their rest area; the sum is the patch's limit-surface area); L is chosen so
+that the samples are closer than a third of the obstacle's smallest radius of curvature.
+
+**Barrier** (IPC, Li et al. 2020): B(x, s) = kappa sum_k w_k b(d_k), b(d) = -(d - dh)^2 ln(d/dh)
+for 0 < d < dh, 0 beyond, +inf at d <= 0.  kappa sets the contact pressure: -kappa b'(dh/2) =
+``pressure_scale`` (default: the shell's Young's modulus, i.e. the barrier layer is as stiff as a
+dh-thick layer of the shell's own material).  The pressure on the shell is p_k = -kappa b'(d_k) > 0
+exactly where d_k < dh; the **contact area** is the sampled area with d_k < dh (pressure > 0).
+
+**Force control.**  The finger is pushed by the force F (= load factor x target) along e, so its
+advance s is an unknown with potential B(x, s) - F s.  It is eliminated exactly: s*(x) solves
+dB/ds = F (a scalar safeguarded Newton solve at every evaluation) and the potential of the control
+points is Pi(x) = B(x, s*(x)) - F s*(x), whose gradient is dB/dx (envelope theorem) and whose
+Hessian is B_xx - B_xs B_xs^T / B_ss (a rank-one part with a negative coefficient, which the
+nonlinear solver handles by the Woodbury identity).  So at every equilibrium the finger's contact
+force along its axis is exactly F, and no configuration can penetrate: for any x the finger sits
+where the barrier force equals F, in front of every sample.  (An obstacle at a prescribed
+position would need a feasible-step limit in the line search; the force-controlled finger does
+not.)  The generalised load of the load factor is -d(grad Pi)/d lam = -B_xs F_target / B_ss.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import ProblemError
+from ..problem.potentials import PotentialTerms
+
+
+class _NoPosition(ProblemError):
+    """No finger advance balances the force for this configuration (a sample point went
+    through the fingertip): the potential is +inf there."""
+
+
+# ---------------------------------------------------------------------------------------------
+# the barrier function
+def log_barrier(d: np.ndarray, dhat: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """b(d) = -(d - dh)^2 ln(d / dh) and its first two derivatives (zero for d >= dh; b = +inf
+    for d <= 0).  Shapes: d (k,) -> three (k,) arrays."""
+    d = np.asarray(d, float)
+    b = np.zeros_like(d)
+    b1 = np.zeros_like(d)
+    b2 = np.zeros_like(d)
+    act = (d > 0) & (d < dhat)
+    x = d[act]
+    r = x - dhat
+    lg = np.log(x / dhat)
+    b[act] = -r * r * lg
+    b1[act] = -2 * r * lg - r * r / x
+    b2[act] = -2 * lg - 4 * r / x + r * r / (x * x)
+    b[d <= 0] = np.inf
+    return b, b1, b2
+
+
+# ---------------------------------------------------------------------------------------------
+# obstacles: distance phi(p) >= 0 outside, with gradient and Hessian (valid outside)
+@dataclass(frozen=True)
+class Capsule:
+    """A capsule (a pin): segment a-b [m] with ``radius`` [m].  Object-frame coordinates."""
+
+    a: tuple
+    b: tuple
+    radius: float
+
+    def inflated(self, r: float) -> "Capsule":
+        return Capsule(self.a, self.b, self.radius + r)
+
+    @property
+    def feature_radius(self) -> float:
+        return self.radius
+
+    def reach(self) -> float:
+        """Lateral extent about the closing axis [m]."""
+        return self.radius
+
+    def distance(self, p: np.ndarray, hessian: bool = True):
+        """phi (k,), grad (k, 3) and (``hessian``) Hessian (k, 3, 3) of the distance to the
+        capsule surface at points p (k, 3) outside it."""
+        a, b = np.asarray(self.a, float), np.asarray(self.b, float)
+        ab = b - a
+        L2 = ab @ ab
+        t = np.clip(((p - a) @ ab) / L2, 0.0, 1.0)
+        v = p - (a + t[:, None] * ab)
+        r = np.maximum(np.sqrt(np.einsum("ki,ki->k", v, v)), 1e-300)
+        n = v / r[:, None]
+        if not hessian:
+            return r - self.radius, n
+        P = np.eye(3)[None] - n[:, :, None] * n[:, None, :]
+        side = (t > 0) & (t < 1)                                # distance to the axis line
+        if side.any():
+            u = ab / np.sqrt(L2)
+            P[side] -= np.outer(u, u)[None]
+        return r - self.radius, n, P / r[:, None, None]
+
+
+@dataclass(frozen=True)
+class RoundedBox:
+    """A box with rounded edges (a pad): centre [m], rotation (3, 3) whose columns are the box
+    axes in the object frame, half extents [m] of the full box, edge radius ``rounding`` [m]."""
+
+    center: tuple
+    rotation: tuple
+    half_extents: tuple
+    rounding: float
+
+    def inflated(self, r: float) -> "RoundedBox":
+        return RoundedBox(self.center, self.rotation, tuple(h + r for h in self.half_extents), self.rounding + r)
+
+    @property
+    def feature_radius(self) -> float:
+        return self.rounding
+
+    def reach(self) -> float:
+        h = np.sort(np.asarray(self.half_extents, float))
+        return float(np.hypot(h[1], h[2]))
+
+    def distance(self, p: np.ndarray, hessian: bool = True):
+        """phi (k,), grad (k, 3) and (``hessian``) Hessian (k, 3, 3) of the distance to the
+        rounded box's surface at points p (k, 3) outside it."""
+        R = np.asarray(self.rotation, float)
+        c = np.asarray(self.center, float)
+        h = np.asarray(self.half_extents, float) - self.rounding        # inner box
+        loc = (p - c) @ R
+        s = np.where(loc < 0, -1.0, 1.0)
+        q = np.abs(loc) - h
+        m = np.maximum(q, 0.0)
+        r = np.sqrt(np.einsum("ki,ki->k", m, m))
+        inside = r <= 0
+        r = np.maximum(r, 1e-300)
+        nl = s * m / r[:, None]
+        phi = np.where(inside, q.max(axis=1), r) - self.rounding
+        n = nl @ R.T
+        if not hessian:
+            return phi, n
+        D = (q > 0).astype(float)
+        Hl = (D[:, :, None] * np.eye(3)[None] - nl[:, :, None] * nl[:, None, :]) / r[:, None, None]
+        return phi, n, R[None] @ Hl @ R.T[None]
+
+
+# ---------------------------------------------------------------------------------------------
+def _samples(shell, ev, faces: np.ndarray, L: int):
+    """Sub-triangle centroids of ``faces`` (L x L per face): stencils (F, S), N (F, q, S) and
+    rest weights (F, q) [m^2]; S padded with zero weights."""
+    pts = []
+    for i in range(L):
+        for j in range(L - i):
+            pts.append(((i + 1 / 3) / L, (j + 1 / 3) / L))
+            if i + j <= L - 2:
+                pts.append(((i + 2 / 3) / L, (j + 2 / 3) / L))
+    pts = np.array(pts)
+    X = shell.rest_positions
+    st_l, N_l, w_l = [], [], []
+    for f in faces:
+        st, N, dN, _ = ev.basis(int(f), pts)
+        a1 = np.einsum("qs,sd->qd", dN[:, :, 0], X[st])
+        a2 = np.einsum("qs,sd->qd", dN[:, :, 1], X[st])
+        st_l.append(st)
+        N_l.append(N)
+        w_l.append(np.linalg.norm(np.cross(a1, a2), axis=1) / (2 * L * L))
+    S = max(len(s) for s in st_l)
+    stn = np.zeros((len(faces), S), np.int64)
+    Nn = np.zeros((len(faces), len(pts), S))
+    for k, (s, N) in enumerate(zip(st_l, N_l)):
+        stn[k, : len(s)] = s
+        Nn[k, :, : len(s)] = N
+    return stn, Nn, np.array(w_l)
+
+
+@dataclass
+class FingerContact:
+    """A force-controlled rigid fingertip against the shell (see the module docstring).
+
+    Parameters
+    ----------
+    obstacle : Capsule | RoundedBox, object frame, at the finger's reference position (s = 0)
+    axis : (3,) closing direction of the finger (from the finger into the object)
+    force : target force [N] along ``axis`` at load factor 1
+    offset : [m] the obstacle is inflated by this (half the wall thickness: the outer skin)
+    dhat : [m] barrier reach (default: 5 % of 2 * offset, or 0.1 mm without an offset)
+    pressure_scale : [Pa] contact pressure at gap dhat/2 (default: the shell's E)
+    reach : [m] lateral sampling radius about the axis (faces whose control centroid is within
+        it; default: the obstacle's lateral extent plus one control-mesh edge)
+    depth : [m] samples are taken on faces at most this far behind the obstacle's front
+        (default: half the shell's extent along the axis)
+    spacing : [m] largest sample spacing (default: a third of the obstacle's smallest radius
+        of curvature, inflated)
+    name : label (e.g. the finger)
+    """
+
+    obstacle: object
+    axis: tuple
+    force: float
+    offset: float = 0.0
+    dhat: float | None = None
+    pressure_scale: float | None = None
+    reach: float | None = None
+    depth: float | None = None
+    spacing: float | None = None
+    name: str = "finger"
+
+    # ---- set-up ------------------------------------------------------------------------------
+    def bind(self, shell, ev) -> "FingerContact":
+        e = np.asarray(self.axis, float)
+        if e.shape != (3,) or not np.all(np.isfinite(e)) or np.linalg.norm(e) == 0:
+            raise ProblemError(f"finger contact '{self.name}': axis must be a non-zero 3-vector, got {self.axis!r}")
+        if not (np.isfinite(self.force) and self.force >= 0):
+            raise ProblemError(f"finger contact '{self.name}': force must be a non-negative number [N], got {self.force!r}")
+        self._e = e / np.linalg.norm(e)
+        self._obs = self.obstacle.inflated(self.offset) if self.offset else self.obstacle
+        self._dh = float(self.dhat if self.dhat is not None else (0.1 * self.offset if self.offset else 1e-4))
+        if not self._dh > 0:
+            raise ProblemError(f"finger contact '{self.name}': dhat must be positive, got {self._dh!r}")
+        mat = shell.material
+        E = getattr(mat, "E", None)
+        if E is None and hasattr(mat, "mu"):
+            E = 3.0 * float(mat.mu)
+        p = float(self.pressure_scale if self.pressure_scale is not None else (E or 1e6))
+        self._kappa = p / (-float(log_barrier(np.array([self._dh / 2]), self._dh)[1][0]))
+        X = shell.rest_positions
+        mesh = shell.mesh
+        real = mesh.faces[: mesh.n_real_faces]
+        edge = float(np.linalg.norm(X[real[:, [1, 2, 0]]] - X[real], axis=-1).mean())
+        cen = X[real].mean(axis=1)
+        # front of the obstacle (its farthest point along e) at s = 0
+        probe = self._front_point(X)
+        rel = cen - probe
+        ax = rel @ self._e
+        lat = np.linalg.norm(rel - ax[:, None] * self._e, axis=1)
+        reach = self.reach if self.reach is not None else self._obs.reach() + edge
+        ext = (X @ self._e).max() - (X @ self._e).min()
+        depth = self.depth if self.depth is not None else 0.5 * ext
+        faces = np.flatnonzero((lat <= reach) & (ax <= depth) & (ax >= -depth))
+        if len(faces) == 0:
+            raise ProblemError(f"finger contact '{self.name}': no shell face within reach ({reach:.3g} m) of the fingertip")
+        spacing = self.spacing if self.spacing is not None else self._obs.feature_radius / 3
+        L = int(np.clip(np.ceil(edge / spacing), 1, 12))
+        self._st, self._N, self._w = _samples(shell, ev, faces, L)
+        self._faces, self._L, self._n = faces, L, shell.n_control
+        self._shell, self._ev = shell, ev
+        self._s = 0.0
+        x_s = self._points(X)
+        phi = self._phi(x_s, 0.0, False)[0]
+        self._first = int(np.argmin(phi))
+        if phi.min() <= -0.5 * self._obs.feature_radius:
+            raise ProblemError(f"finger contact '{self.name}': the fingertip starts {-phi.min():.3g} m inside the shell "
+                               "(its reference position must touch the outer surface)")
+        # start where the obstacle no longer reaches any sample (retracted by the overlap + dhat)
+        self._s = min(0.0, float(phi.min()) - self._dh)
+        self._s0 = self._s - 2 * self._dh - 0.5 * float(np.ptp(X @ self._e))
+        return self
+
+    def _front_point(self, X):
+        # a point of the obstacle's front: the obstacle's distance-minimising point towards the
+        # shell's centroid, approximated by stepping from the centroid back along -e
+        c = X.mean(axis=0)
+        phi, n = self._obs.distance(c[None], False)
+        return c - phi[0] * n[0]
+
+    # ---- kinematics --------------------------------------------------------------------------
+    def _points(self, x: np.ndarray) -> np.ndarray:
+        """Sample points (F, q, 3) of control points x (n, 3)."""
+        return np.einsum("fqs,fsd->fqd", self._N, x[self._st])
+
+    def _phi(self, pts: np.ndarray, s: float, hessian: bool = True):
+        shp = pts.shape[:-1]
+        out = self._obs.distance(pts.reshape(-1, 3) - s * self._e, hessian)
+        return tuple(o.reshape(shp + o.shape[1:]) for o in out)
+
+    def _g(self, pts, kw, s):
+        """(B_s, B_ss, feasible) at advance s for flat sample points pts (k, 3), weights kw (k,)."""
+        d, n = self._obs.distance(pts - s * self._e, False)
+        if np.any(d <= 0):
+            return np.inf, 0.0, False
+        act = d < self._dh
+        if not act.any():
+            return 0.0, 0.0, True
+        _, b1, b2 = log_barrier(d[act], self._dh)
+        _, na, Ha = self._obs.distance(pts[act] - s * self._e, True)
+        ds = -(na @ self._e)
+        dss = np.einsum("i,kij,j->k", self._e, Ha, self._e)
+        kw = kw[act]
+        return float((kw * b1 * ds).sum()), float((kw * (b2 * ds * ds + b1 * dss)).sum()), True
+
+    def advance(self, x: np.ndarray, F: float) -> float:
+        """The finger's advance s* [m] where the barrier force along e equals F [N] (F > 0).
+
+        Safeguarded Newton on dB/ds = F from the last solution, over the samples that can reach
+        the barrier within a window |s - s_c| < W around a centre s_c (|d d/d s| <= 1, so the
+        others are inactive and feasible there); the window moves when an iterate leaves it."""
+        P = self._points(x).reshape(-1, 3)
+        KW = (self._kappa * self._w).ravel()
+        W = 8 * self._dh
+        sel = {}
+
+        def window(sc):
+            d = self._obs.distance(P - sc * self._e, False)[0]
+            idx = np.flatnonzero(d < self._dh + W)
+            sel.update(c=sc, p=P[idx], kw=KW[idx])
+
+        def G(t):
+            if abs(t - sel["c"]) >= W:
+                window(t)
+            g, gs, ok = self._g(sel["p"], sel["kw"], t)
+            return (g - F if ok else np.inf), gs, ok
+
+        def dmin(t):
+            return float(self._obs.distance(P - t * self._e, False)[0].min())
+
+        def bracket(s):
+            """(lo, hi): G(lo) < 0 <= G(hi); advancing conservatively (never by more than 0.9 of
+            the smallest gap, so the fingertip cannot jump over a sample)."""
+            window(s)
+            Gs = G(s)[0]
+            step = self._dh
+            if Gs < 0:
+                lo = s
+                for _ in range(200):
+                    dm = dmin(lo)
+                    t = lo + min(step, 0.9 * dm)
+                    if G(t)[0] >= 0:
+                        return lo, t
+                    lo, step = t, 2 * step
+            else:
+                hi = s
+                for _ in range(60):
+                    t = hi - step
+                    if G(t)[0] < 0:
+                        return t, hi
+                    hi, step = t, 2 * step
+            return None
+
+        br = bracket(self._s) or bracket(0.0)
+        if br is None:
+            raise _NoPosition(f"finger contact '{self.name}': no finger position balances {F:.6g} N "
+                              "(a shell point is behind the fingertip)")
+        lo, hi = br
+        s = lo
+        Gs, gs, ok = G(s)
+        for _ in range(200):                                    # safeguarded Newton
+            if abs(Gs) <= 1e-12 * F or hi - lo <= 1e-15 * max(abs(lo), self._dh):
+                break
+            t = s - Gs / gs if (ok and gs > 0) else np.nan
+            if not (lo < t < hi):
+                t = 0.5 * (lo + hi)
+            Gt, gt, okt = G(t)
+            if Gt < 0:
+                lo = t
+            else:
+                hi = t
+            if okt:
+                small = abs(t - s) <= 1e-13 * self._dh
+                s, Gs, gs, ok = t, Gt, gt, okt
+                if small:
+                    break
+        self._s = s
+        return s
+
+    # ---- potential interface ---------------------------------------------------------------------
+    def scaled(self) -> bool:
+        return True
+
+    def _terms(self, x, F, order):
+        """(s*, value, gradient (3n,), Hessian B_xx or None, B_ss, B_xs (3n,)) at force F > 0;
+        order 1: gradient only, order 2: + B_ss and B_xs, order 3: + B_xx."""
+        key = getattr(self, "_key", None)
+        if key is not None and key[1] == F and np.array_equal(key[0], x):
+            s = key[2]
+        else:
+            s = self.advance(x, F)
+            self._key = (x.copy(), F, s)
+        pts = self._points(x)
+        d, n = self._phi(pts, s, False)
+        af = np.flatnonzero(np.any(d < self._dh, axis=1))       # faces with active samples
+        pts, d, n = pts[af], d[af], n[af]
+        N, st = self._N[af], self._st[af]
+        b, b1, b2 = (a.reshape(d.shape) for a in log_barrier(d.ravel(), self._dh))
+        kw = self._kappa * self._w[af]
+        value = float((kw * b).sum()) - F * s
+        gk = (kw * b1)[..., None] * n                           # dB/dp_k  (F, q, 3)
+        grad = np.zeros((self._n, 3))
+        np.add.at(grad, st, np.einsum("fqs,fqd->fsd", N, gk))
+        if order < 2:
+            return s, value, grad.ravel(), None, None, None
+        H = self._phi(pts, s, True)[2]
+        ds = -(n @ self._e)
+        He = H @ self._e
+        Bss = float((kw * (b2 * ds * ds + b1 * np.einsum("...i,...i->...", He, self._e))).sum())
+        vk = (kw * b2 * ds)[..., None] * n - (kw * b1)[..., None] * He      # d2B/dp_k ds
+        v = np.zeros((self._n, 3))
+        np.add.at(v, st, np.einsum("fqs,fqd->fsd", N, vk))
+        if order < 3:
+            return s, value, grad.ravel(), None, Bss, v.ravel()
+        Hk = (kw * b2)[..., None, None] * n[..., :, None] * n[..., None, :] + (kw * b1)[..., None, None] * H
+        Nf, Hf, stf = N, Hk, st
+        blocks = np.einsum("fqa,fqb,fqij->faibj", Nf, Nf, Hf)
+        rows = 3 * stf[:, :, None, None, None] + np.arange(3)[None, None, :, None, None]
+        cols = 3 * stf[:, None, None, :, None] + np.arange(3)[None, None, None, None, :]
+        shp = blocks.shape
+        Hm = sp.csr_matrix((blocks.ravel(), (np.broadcast_to(rows, shp).ravel(), np.broadcast_to(cols, shp).ravel())),
+                           shape=(3 * self._n, 3 * self._n))
+        return s, value, grad.ravel(), Hm, Bss, v.ravel()
+
+    def evaluate(self, x: np.ndarray, lam: float, order: int = 2) -> PotentialTerms:
+        F = lam * self.force
+        self._last = (x.copy(), F, None)
+        if F <= 0:                                          # no push: the finger is retracted
+            z = sp.csr_matrix((3 * self._n, 3 * self._n)) if order >= 2 else None
+            return PotentialTerms(0.0, np.zeros(3 * self._n) if order >= 1 else None, z)
+        try:
+            s, value, grad, Hm, Bss, v = self._terms(x, F, 3 if order >= 2 else (2 if order == 1 else 1))
+        except _NoPosition:                                 # infeasible: the solver backs off
+            return PotentialTerms(np.inf, None if order == 0 else np.full(3 * self._n, np.nan),
+                                  sp.csr_matrix((3 * self._n, 3 * self._n)) if order >= 2 else None)
+        if order == 0:
+            return PotentialTerms(value, None, None)
+        self._last = (self._last[0], F, (Bss, v))
+        if order < 2:
+            return PotentialTerms(value, grad, None)
+        r1 = [(-1.0 / Bss, v)] if Bss > 0 else []
+        return PotentialTerms(value, grad, Hm, r1)
+
+    def load(self, x: np.ndarray) -> np.ndarray:
+        """-d(grad Pi)/d lam = -B_xs F_target / B_ss at the force of the last evaluation; with no
+        push yet, the target force at the sample that the finger meets first."""
+        last = getattr(self, "_last", None)
+        F = last[1] if last is not None and np.array_equal(last[0], x) else None
+        if self.force == 0:
+            return np.zeros(3 * self._n)
+        if F is None or F <= 0:
+            q = np.zeros((self._n, 3))
+            f, k = divmod(self._first, self._N.shape[1])
+            np.add.at(q, self._st[f], self._N[f, k][:, None] * (self.force * self._e)[None])
+            return q.ravel()
+        if last[2] is not None:
+            Bss, v = last[2]
+        else:
+            try:
+                _, _, _, _, Bss, v = self._terms(x, F, 2)
+            except _NoPosition:
+                return np.full(3 * self._n, np.nan)
+        if not Bss > 0:
+            return np.zeros(3 * self._n)
+        return -v * self.force / Bss
+
+    def commit(self, x: np.ndarray) -> None:
+        pass
+
+    def touch(self, x: np.ndarray, tol: float = 1e-9) -> float:
+        """The advance [m] at which the (inflated) fingertip first touches the samples of control
+        points x (n, 3): sphere tracing from the retracted position (|d d/d s| <= 1, so stepping
+        by the smallest gap never passes through the surface)."""
+        P = self._points(x).reshape(-1, 3)
+        s = self._s0
+        for _ in range(10000):
+            dm = float(self._obs.distance(P - s * self._e, False)[0].min())
+            if dm <= tol:
+                return s
+            s += dm
+        return s
+
+    # ---- reporting ---------------------------------------------------------------------------
+    def report(self, x: np.ndarray, lam: float, check_level: int = 3) -> dict:
+        """Finger advance, contact force (vector and along the axis), contact area (sampled area
+        with gap < dhat, i.e. pressure > 0), peak and mean pressure, smallest gap at the samples
+        and on a ``check_level`` times finer grid (x: control points (n, 3))."""
+        F = lam * self.force
+        base = {"name": self.name, "target_force_N": F, "dhat_m": self._dh, "axis": self._e.tolist(),
+                "n_samples": int(self._w.size), "samples_per_face": int(self._w.shape[1])}
+        if F <= 0:
+            return dict(base, advance_m=0.0, contact_area_m2=0.0)
+        s = self.advance(x, F)
+        d, n = self._phi(self._points(x), s, False)
+        _, b1, _ = log_barrier(d.ravel(), self._dh)
+        p = -self._kappa * b1.reshape(d.shape)                    # pressure on the shell [Pa]
+        f = ((p * self._w)[..., None] * n).reshape(-1, 3).sum(axis=0)   # force on the shell
+        act = d < self._dh
+        area = float(self._w[act].sum())
+        st, N, _ = _samples(self._shell, self._ev, self._faces, self._L * check_level)
+        d_fine = self._phi(np.einsum("fqs,fsd->fqd", N, x[st]), s, False)[0]
+        return dict(base, advance_m=s, contact_force_N=f.tolist(), contact_force_along_axis_N=float(f @ self._e),
+                    contact_area_m2=area, peak_pressure_Pa=float(p.max()),
+                    mean_pressure_Pa=float(F / area) if area > 0 else 0.0,
+                    min_gap_m=float(d.min()), min_gap_fine_m=float(d_fine.min()), n_active=int(act.sum()))

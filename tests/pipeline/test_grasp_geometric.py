@@ -1,0 +1,54 @@
+"""``--contact geometric`` end to end: the tennis ball (coarse 320-face control mesh) squeezed by
+the pad gripper (scenes/tennis_ball/scene_pad.xml), the fingertips as rigid force-controlled
+obstacles (graspdef.contact.barrier)."""
+import json
+
+import numpy as np
+import pytest
+
+import mujoco  # noqa: F401  (the sim extra is part of make test)
+
+from graspdef.pipeline import run_grasp
+
+PADS = "scenes/tennis_ball/scene_pad.xml"
+
+
+def _check(r, force):
+    for s in ("left", "right"):
+        f = r["fingers"][s]
+        assert f["contact_force_along_axis_N"] == pytest.approx(force, rel=1e-8)     # force control
+        assert f["contact_area_m2"] > 0
+        g = r["geometric_contact"]["fingers"][s]
+        assert g["min_gap_m"] > 0 and g["min_gap_fine_m"] > 0                     # no penetration
+    # MuJoCo's friction and the weight stay dead loads: with the contact forces they balance to
+    # the lateral force of the frictionless contact (small for this symmetric grasp)
+    assert np.linalg.norm(r["residual"]["net_force_N"]) < 0.05 * force
+    assert r["convergence"]["completed"]
+
+
+def test_tennis_ball_pads_geometric_nonlinear(tmp_path):
+    """Neo-Hookean ball with its 80 kPa air, 3 N per pad: the fingers' force along their axes is
+    the target, nothing penetrates, the run folder is complete; the contact patch is much larger
+    than a pin's (the pad flattens the ball)."""
+    out = tmp_path / "run"
+    r = run_grasp(PADS, 3.0, "geometric", "nonlinear", out, control_faces=320).result
+    _check(r, 3.0)
+    ind = r["feedback"]["indentation_per_finger_m"]
+    assert 0 < ind < 5e-3
+    assert r["contact_area_m2"] / 2 > 2e-5                      # > 20 mm^2 per pad
+    rec = json.loads((out / "result.json").read_text())
+    assert rec["contact"] == "geometric" and rec["contact_area_m2"] > 0
+    for f in ("result.json", "contacts.json", "deformed.ply", "undeformed.ply", "path.csv"):
+        assert (out / f).is_file()
+
+
+@pytest.mark.slow
+def test_tennis_ball_contact_area_grows_with_load():
+    """Linear shell with pad contact at 1 and 3 N: the contact area grows with the load, the
+    indentation too (and less than proportionally: the patch stiffens as it grows)."""
+    rs = [run_grasp(PADS, f, "geometric", "linear", None, control_faces=320).result for f in (1.0, 3.0)]
+    for r, f in zip(rs, (1.0, 3.0)):
+        _check(r, f)
+    assert rs[0]["contact_area_m2"] < rs[1]["contact_area_m2"]
+    i0, i1 = (r["feedback"]["indentation_per_finger_m"] for r in rs)
+    assert 0 < i0 < i1
