@@ -4,17 +4,17 @@ finger (Table I's fourth row), superposed on the undeformed ball.
 Paper: the two contact points move 10.27 mm (measured); the deformed regions (bordered by red
 curves in the paper) are local around the contacts; the nonlinear result is "within 7 %" of the
 scan.  graspdef (full mode): neo-Hookean shell, E = 1 MPa, t = 2.5 mm, 80 kPa air, point loads
-from the settled MuJoCo grasp: 15.44 mm per finger -- 1.5x the measurement (not reproduced; see
-paper_table1_grasps.py and docs/grasp.md for why).  The paper's ball "hardly deforms" away from
-the contacts; graspdef's ball with air ovalises and moves there by several mm (rigid motion
-removed) -- printed as the far-field |u| (the largest displacement farther than one radius from
-both contacts).  The picture colours |u|.
+from the settled MuJoCo grasp, displacements from the unloaded (inflated) ball: 19.57 mm per
+finger -- 1.9x the measurement (not reproduced; see paper_table1_grasps.py and docs/grasp.md).
+Away from the contacts the ball moves little, as in the paper: printed as the far-field |u| (the
+largest displacement, rigid motion removed, farther than one radius from both contacts; 2.0 mm).
+The picture colours |u|.
 
 Fast mode: the same nonlinear run on a coarse control mesh (320 faces, 162 vertices; full: 1,280
-faces, 642 vertices): 13.6 mm.  Its assertions: an invariant of the antipodal grasp (the two
-contact points move equally, rigid motion removed), the mesh trend (the point load's dimple deepens with
-refinement: coarse below the full-mode 15.44 mm, within 20 %) and that the dimples dominate
-(far-field |u| below the indentation).
+faces, 642 vertices): 17.71 mm.  Its assertions: an invariant of the antipodal grasp (the two
+contact points move equally, rigid motion removed), the mesh trend (the point load's dimple
+deepens with refinement: coarse below the full-mode 19.57 mm, within 20 %) and that the dimples
+dominate (far-field |u| below the indentation).
 
     python scripts/gallery/paper_fig13_tennis_ball.py [--out DIR] [--fast] [--contact point]
 """

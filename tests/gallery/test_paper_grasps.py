@@ -2,7 +2,7 @@
 in fast mode.  The published values are not reproduced with the paper's E = 1 MPa (docs/grasp.md);
 the assertions are analytic values where they exist, invariants of the chain, and mesh trends.
 The duck tests are marked slow: building the duck's shell (decimated scan, mostly irregular faces,
-exact Loop evaluation) and solving took 75-80 s per test on the shared machine, even on the coarse
+exact Loop evaluation) and solving took 30-80 s per test on the shared machine, even on the coarse
 control mesh."""
 import pytest
 
@@ -21,13 +21,14 @@ def test_table1_grasps(run_fast):
 
 def test_fig13_tennis_ball(run_fast):
     """Fig. 13 (neo-Hookean, 80 kPa air, 162 control vertices): the two contact points move
-    equally, rigid motion removed (5 %); the coarse mesh's indentation is below the full mode's 15.44 mm (642 vertices)
-    and within 20 % of it; the dimples dominate (far-field |u| below the indentation)."""
+    equally, rigid motion removed (5 %); the coarse mesh's indentation is below the full mode's
+    19.57 mm (642 vertices; displacements from the inflated ball) and within 20 % of it; the
+    dimples dominate (far-field |u| below the indentation)."""
     k = run_fast("paper_fig13_tennis_ball")["key"]
     a = list(k["contact_displacement_mm"].values())
     assert len(a) == 2 and abs(a[0] / a[1] - 1) < 0.05, a
     assert k["completed"]
-    assert 0.8 * 15.44 < k["indentation_per_finger_mm"] < 15.44, k
+    assert 0.8 * 19.57 < k["indentation_per_finger_mm"] < 19.57, k
     assert k["far_field_max_displacement_mm"] < k["indentation_per_finger_mm"], k
 
 
