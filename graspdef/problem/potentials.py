@@ -11,7 +11,7 @@ points so that the tangent stays symmetric and exact.
   cross-section about a fixed axis e: potential ``-lam m int theta ds`` with theta the rotation of
   the surface tangent across the edge about e (exact for the rolling-up cantilever).
 
-``evaluate(x, lam)`` returns a :class:`PotentialTerms` (value, gradient, Hessian, rank-one
+``evaluate(x, lam, order)`` returns a :class:`PotentialTerms` (value, gradient, Hessian, rank-one
 parts) and ``load(x)`` the generalised force -d(value)/d(lam) that the load factor scales (zero
 for the gas).  States change branch only through ``commit(x)`` at a converged step (the edge
 rotation is tracked continuously past +-pi).
@@ -70,11 +70,13 @@ class FollowerPressure:
         return True
 
     def evaluate(self, x: np.ndarray, lam: float, order: int = 2) -> PotentialTerms:
+        if order == 0:
+            return PotentialTerms(-lam * self.p * self._vol.value(x), None, None)
         if order < 2:
             V, g = self._vol.gradient(x)
             return PotentialTerms(-lam * self.p * V, -lam * self.p * g, None)
-        V, g, H = self._vol.hessian(x)
-        return PotentialTerms(-lam * self.p * V, -lam * self.p * g, (-lam * self.p) * H)
+        V, g, H = self._vol.hessian(x, scale=-lam * self.p)
+        return PotentialTerms(-lam * self.p * V, -lam * self.p * g, H)
 
     def load(self, x: np.ndarray) -> np.ndarray:
         return self.p * self._vol.gradient(x)[1]
@@ -116,13 +118,16 @@ class EnclosedGas:
         return -(self.p_atm + self.p0) * self.V0 * np.log(V / self.V0) + self.p_atm * (V - self.V0)
 
     def evaluate(self, x: np.ndarray, lam: float, order: int = 2) -> PotentialTerms:
+        if order == 0:
+            return PotentialTerms(self._value(self._vol.value(x)), None, None)
         if order < 2:
             V, g = self._vol.gradient(x)
             return PotentialTerms(self._value(V), -self.gauge_pressure(V) * g, None)
-        V, g, H = self._vol.hessian(x)
+        V = self._vol.value(x)
         pg = self.gauge_pressure(V)
+        V, g, H = self._vol.hessian(x, scale=-pg)
         c = (self.p_atm + self.p0) * self.V0 / V ** 2
-        return PotentialTerms(self._value(V), -pg * g, (-pg) * H, [(c, g)])
+        return PotentialTerms(self._value(V), -pg * g, H, [(c, g)])
 
     def load(self, x: np.ndarray) -> np.ndarray:
         return np.zeros(3 * len(x))

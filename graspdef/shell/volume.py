@@ -64,6 +64,88 @@ def _hessian_blocks(N, dN, p, a1, a2, w, stride):
     return out
 
 
+@nb.njit(cache=True)
+def _volume_terms(x, stencils, N, dN, w, nstride, order, index, base, bstride, grad, data):
+    """Fused value / gradient (order >= 1) / Hessian (order 2, added into the scalar CSR ``data``
+    of the shell's block pattern: block p = index[(f S + s) S + t], entry (a, b) at
+    base[p] + a bstride[p] + b) of V over one face group; sequential (no scatter races).
+    N (f|1, q, S), dN (f|1, q, S, 2), w (q,) including the 1/3; returns V."""
+    nf, S = stencils.shape
+    nq = w.shape[0]
+    V = 0.0
+    p = np.empty((nq, 3))
+    a1 = np.empty((nq, 3))
+    a2 = np.empty((nq, 3))
+    for f in range(nf):
+        fb = f * nstride
+        for q in range(nq):
+            for d in range(3):
+                sp_ = 0.0
+                s1 = 0.0
+                s2 = 0.0
+                for s in range(S):
+                    xv = x[stencils[f, s], d]
+                    sp_ += N[fb, q, s] * xv
+                    s1 += dN[fb, q, s, 0] * xv
+                    s2 += dN[fb, q, s, 1] * xv
+                p[q, d] = sp_
+                a1[q, d] = s1
+                a2[q, d] = s2
+            m0 = a1[q, 1] * a2[q, 2] - a1[q, 2] * a2[q, 1]
+            m1 = a1[q, 2] * a2[q, 0] - a1[q, 0] * a2[q, 2]
+            m2 = a1[q, 0] * a2[q, 1] - a1[q, 1] * a2[q, 0]
+            V += w[q] * (p[q, 0] * m0 + p[q, 1] * m1 + p[q, 2] * m2)
+            if order >= 1:
+                # dV = w [N_s (a1 x a2) + dN1_s (a2 x p) + dN2_s (p x a1)]
+                b0 = a2[q, 1] * p[q, 2] - a2[q, 2] * p[q, 1]
+                b1 = a2[q, 2] * p[q, 0] - a2[q, 0] * p[q, 2]
+                b2 = a2[q, 0] * p[q, 1] - a2[q, 1] * p[q, 0]
+                c0 = p[q, 1] * a1[q, 2] - p[q, 2] * a1[q, 1]
+                c1 = p[q, 2] * a1[q, 0] - p[q, 0] * a1[q, 2]
+                c2 = p[q, 0] * a1[q, 1] - p[q, 1] * a1[q, 0]
+                for s in range(S):
+                    Ns, d1, d2 = w[q] * N[fb, q, s], w[q] * dN[fb, q, s, 0], w[q] * dN[fb, q, s, 1]
+                    r = stencils[f, s]
+                    grad[r, 0] += Ns * m0 + d1 * b0 + d2 * c0
+                    grad[r, 1] += Ns * m1 + d1 * b1 + d2 * c1
+                    grad[r, 2] += Ns * m2 + d1 * b2 + d2 * c2
+        if order < 2:
+            continue
+        for s in range(S):
+            for t in range(s + 1, S):
+                v0 = 0.0
+                v1 = 0.0
+                v2 = 0.0
+                for q in range(nq):
+                    Ns, Nt = N[fb, q, s], N[fb, q, t]
+                    d1s, d1t = dN[fb, q, s, 0], dN[fb, q, t, 0]
+                    d2s, d2t = dN[fb, q, s, 1], dN[fb, q, t, 1]
+                    ca2 = w[q] * (d1s * Nt - Ns * d1t)
+                    ca1 = w[q] * (Ns * d2t - d2s * Nt)
+                    cp = w[q] * (d2s * d1t - d1s * d2t)
+                    v0 += ca2 * a2[q, 0] + ca1 * a1[q, 0] + cp * p[q, 0]
+                    v1 += ca2 * a2[q, 1] + ca1 * a1[q, 1] + cp * p[q, 1]
+                    v2 += ca2 * a2[q, 2] + ca1 * a1[q, 2] + cp * p[q, 2]
+                # block (s, t) = [v]_x, block (t, s) = its transpose
+                k = index[(f * S + s) * S + t]
+                o, st_ = base[k], bstride[k]
+                data[o + 1] -= v2
+                data[o + 2] += v1
+                data[o + st_] += v2
+                data[o + st_ + 2] -= v0
+                data[o + 2 * st_] -= v1
+                data[o + 2 * st_ + 1] += v0
+                k = index[(f * S + t) * S + s]
+                o, st_ = base[k], bstride[k]
+                data[o + 1] += v2
+                data[o + 2] -= v1
+                data[o + st_] -= v2
+                data[o + st_ + 2] += v0
+                data[o + 2 * st_] += v1
+                data[o + 2 * st_ + 1] -= v0
+    return V
+
+
 class EnclosedVolume:
     """Volume functional of a shell's limit surface (all real faces, or a boolean face mask)."""
 
@@ -95,7 +177,44 @@ class EnclosedVolume:
         a2 = np.einsum("fqs,fsd->fqd", dN[..., 1], X)
         return N, dN, p, a1, a2
 
+    # ---- compiled path (``_volume_terms``) ---------------------------------------------------
+    def _compiled(self, x: np.ndarray, order: int, hessian_scale: float = 1.0):
+        x = np.ascontiguousarray(x, dtype=float).reshape(self.shell.n_control, 3)
+        w = np.ascontiguousarray(self.shell.basis.qweights / 3.0)
+        grad = np.zeros((self.shell.n_control, 3))
+        pat = self.pattern if order == 2 else None
+        data = np.zeros(9 * pat.nnzb) if order == 2 else np.zeros(1)
+        empty = np.zeros(1, np.int64)
+        V = 0.0
+        for gi, g in enumerate(self.shell.basis.groups):
+            V += _volume_terms(x, np.ascontiguousarray(g.stencils), np.ascontiguousarray(g.N),
+                               np.ascontiguousarray(g.dN), w, 0 if g.N.shape[0] == 1 else 1, order,
+                               pat.maps[gi] if pat is not None else empty,
+                               pat.base if pat is not None else empty, pat.stride if pat is not None else empty,
+                               grad, data)
+        H = None
+        if order == 2:
+            if hessian_scale != 1.0:
+                data *= hessian_scale
+            H = sp.csr_matrix((data, pat.scalar_indices, pat.scalar_indptr), shape=(3 * pat.n, 3 * pat.n))
+        return float(V), grad.ravel(), H
+
     def value(self, x: np.ndarray) -> float:
+        """V [m^3] at control points ``x`` (n_control, 3) [m]."""
+        return self._compiled(x, 0)[0]
+
+    def gradient(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """V and dV/dx (3 n_control,) [m^2]."""
+        V, g, _ = self._compiled(x, 1)
+        return V, g
+
+    def hessian(self, x: np.ndarray, scale: float = 1.0) -> tuple[float, np.ndarray, sp.csr_matrix]:
+        """V, dV/dx and ``scale`` d2V/dx2 (3 n_control, 3 n_control) [m] on the shell's block
+        pattern (the same CSR structure as :class:`~graspdef.shell.energy.ShellEnergy`'s Hessian)."""
+        return self._compiled(x, 2, scale)
+
+    # ---- numpy reference path (tests) ---------------------------------------------------------
+    def _value_reference(self, x: np.ndarray) -> float:
         """V [m^3] at control points ``x`` (n_control, 3) [m]."""
         w = self.shell.basis.qweights / 3.0
         V = 0.0
@@ -104,8 +223,7 @@ class EnclosedVolume:
             V += float(np.einsum("fqd,fqd,q->", p, np.cross(a1, a2), w))
         return V
 
-    def gradient(self, x: np.ndarray) -> tuple[float, np.ndarray]:
-        """V and dV/dx (3 n_control,) [m^2]."""
+    def _gradient_reference(self, x: np.ndarray) -> tuple[float, np.ndarray]:
         w = self.shell.basis.qweights / 3.0
         V = 0.0
         grad = np.zeros((self.shell.n_control, 3))
@@ -119,8 +237,7 @@ class EnclosedVolume:
             np.add.at(grad, g.stencils[sl], ge)
         return V, grad.ravel()
 
-    def hessian(self, x: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
-        """V, dV/dx and d2V/dx2 (3 n_control, 3 n_control) [m] on the shell's block pattern."""
+    def _hessian_reference(self, x: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
         w = self.shell.basis.qweights / 3.0
         V = 0.0
         grad = np.zeros((self.shell.n_control, 3))

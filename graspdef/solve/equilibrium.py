@@ -30,6 +30,14 @@ from ..shell.energy import ShellEnergy
 from .sparse import KKTSystem
 
 
+def _add(A: sp.spmatrix, B: sp.spmatrix) -> sp.csr_matrix:
+    """A + B; entry by entry when both are CSR on the same structure (the shell pattern)."""
+    if (sp.isspmatrix_csr(A) and sp.isspmatrix_csr(B) and A.nnz == B.nnz and A.has_sorted_indices
+            and B.has_sorted_indices and np.array_equal(A.indptr, B.indptr) and np.array_equal(A.indices, B.indices)):
+        return sp.csr_matrix((A.data + B.data, A.indices, A.indptr), shape=A.shape)
+    return (A + B).tocsr()
+
+
 @dataclass
 class State:
     """Energy, gradient, Hessian and load direction at (x, lam)."""
@@ -88,16 +96,16 @@ class Equilibrium:
             internal = grad
             grad = grad - lam * self.f
             if order == 2 and self.nitsche:
-                H = (H + Hn).tocsr()
+                H = _add(H, Hn)
         for pot in self.potentials:
-            t = pot.evaluate(x, lam, order=max(order, 1))
+            t = pot.evaluate(x, lam, order=order)
             E += t.value
             if order >= 1:
                 grad = grad + t.gradient
                 q = q + pot.load(x)
             if order == 2:
                 if t.hessian is not None:
-                    H = (H + t.hessian).tocsr()
+                    H = _add(H, t.hessian)
                 rank_one += t.rank_one
         return State(float(E), grad, H if order == 2 else None, rank_one, q, internal)
 

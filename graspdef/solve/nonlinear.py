@@ -59,8 +59,9 @@ class PathOptions:
     line_search : energy back-tracking in load control
     max_probe_displacement : [m] the path also ends (completed) once a probe has moved this far
         (for paths whose load never reaches ``max_load``, e.g. past a pressure maximum)
-    reuse_factorisation, reuse_ratio : in load control, factorise the tangent once per step and
-        reuse it while the residual contracts by reuse_ratio per iteration (modified Newton)
+    reuse_factorisation, reuse_ratio : in load control, reuse a factorised tangent (the previous
+        converged point's) while the residual contracts by reuse_ratio per iteration (modified Newton)
+    anderson : depth of the Anderson mixing of the modified-Newton corrections (0: plain)
     refine_critical : arc-length bisections that narrow a change of stability down (each halves
         the bracket; the load factor at a limit point is then accurate to O(bracket^2))
     """
@@ -79,7 +80,8 @@ class PathOptions:
     max_probe_displacement: float | None = None
     refine_critical: int = 12
     reuse_factorisation: bool = True
-    reuse_ratio: float = 0.2
+    reuse_ratio: float = 0.5
+    anderson: int = 5
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -94,6 +96,8 @@ class PathOptions:
             raise ProblemError(f"tol must lie in (0, 1e-2), got {self.tol!r}")
         if not (0 < self.min_step < 1):
             raise ProblemError(f"min_step must lie in (0, 1), got {self.min_step!r}")
+        if not isinstance(self.anderson, (int, np.integer)) or self.anderson < 0:
+            raise ProblemError(f"anderson must be a non-negative integer, got {self.anderson!r}")
         if not (0 < self.reuse_ratio < 1):
             raise ProblemError(f"reuse_ratio must lie in (0, 1), got {self.reuse_ratio!r}")
         if not self.max_growth > 1:
@@ -223,26 +227,37 @@ class PathSolver:
             float(np.linalg.norm(cres)) <= 1e-9 * cscale
         return ok, rn / scale
 
-    def newton(self, u0: np.ndarray, lam: float):
+    def newton(self, u0: np.ndarray, lam: float, factored: bool = False):
         """Equilibrium at fixed load factor from u0; returns (u, state, iterations, instability).
 
-        The tangent is factorised at the first iteration; later iterations reuse it (modified
-        Newton: a gradient and a back-substitution each) as long as the residual contracts by
-        ``reuse_ratio`` per iteration, and refactorise when it does not (every iteration when
-        ``reuse_factorisation`` is off)."""
+        Modified Newton with Anderson acceleration: a factorised tangent is reused (a gradient
+        and a back-substitution per iteration) as long as the residual contracts by
+        ``reuse_ratio`` per iteration, and the corrections of the iterations since the last
+        factorisation are combined by Anderson mixing (depth ``anderson``; the least-squares
+        combination of the preconditioned residuals, Walker & Ni 2011), which turns the linear
+        convergence of the stale tangent into nearly the Newton rate.  A fresh tangent is
+        factorised when the contraction is poor (every iteration when ``reuse_factorisation``
+        is off).  ``factored``: the current factorisation (of a nearby state, e.g. the previous
+        converged point) may serve from the first iteration.  The converged state is always
+        factorised itself: its inertia is the reported stability, and it is the tangent of the
+        next step's predictor and iterations."""
         eq, opt = self.eq, self.opt
         u = u0.copy()
-        inst = None
         first = prev = None
-        need_h = True
+        need_h = not (factored and opt.reuse_factorisation)
+        hist: list[tuple[np.ndarray, np.ndarray]] = []      # (u_k, du_k) since the factorisation
+        back = None                                          # state before an Anderson step
         for it in range(opt.max_iterations + 1):
             st = eq.evaluate(u, lam, 2 if need_h else 1)
-            ok, rel = self._converged(st, u, lam)
             if not np.isfinite(st.energy) or not np.all(np.isfinite(st.gradient)):
-                raise _Failed(f"non-finite energy or forces at load factor {lam:.6g}")
+                if back is None:
+                    raise _Failed(f"non-finite energy or forces at load factor {lam:.6g}")
+                (u, st), back, hist = back, None, []       # e.g. through a contact barrier: plain step
+            ok, rel = self._converged(st, u, lam)
             if ok:
-                if inst is None:
-                    inst = eq.factor(st if st.hessian is not None else eq.evaluate(u, lam, 2))
+                if st.hessian is None:
+                    st = eq.evaluate(u, lam, 2)
+                inst = eq.factor(st)
                 return u, st, it, inst
             if it == opt.max_iterations:
                 break
@@ -253,23 +268,53 @@ class PathSolver:
                 st = eq.evaluate(u, lam, 2)                 # poor contraction: fresh tangent
                 need_h = True
             if need_h:
-                inst = eq.factor(st)
+                eq.factor(st)
+                hist = []
             cres = eq.constraint_residual(u, lam)
             du = eq.solve(-st.gradient, cres)
+            # the supports hold to solve precision: the step need not restore them, and the energy
+            # is a merit function along it
+            feasible = float(np.linalg.norm(cres)) <= 1e-8 * max(float(np.linalg.norm(u)), float(np.linalg.norm(du)),
+                                                                 1e-300)
             alpha = 1.0
-            if opt.line_search and float(np.linalg.norm(cres)) <= 1e-12 * max(float(np.linalg.norm(u)), 1e-300):
+            step = du
+            if feasible and opt.anderson and hist:
+                # Anderson mixing (type II) of the fixed-point map u -> u + du
+                dU = np.stack([u - hu for hu, _ in hist], 1)
+                dF = np.stack([du - hf for _, hf in hist], 1)
+                gam, *_ = np.linalg.lstsq(dF, du, rcond=None)
+                step = du - (dU + dF) @ gam
+                back = (u, st)
+            elif opt.line_search and feasible:
+                back = None
                 slope = float(st.gradient @ du)
-                if slope < 0:
+                # energy differences below ~1e-10 |Pi| are round-off: the Armijo test is then
+                # meaningless (it would cut steps at random), and near the solution the Newton
+                # step is accepted as it is
+                if slope < 0 and -slope > 1e-10 * abs(st.energy):
+                    e_new = eq.energy(u + du, lam)
+                    if not need_h and not (np.isfinite(e_new) and e_new <= st.energy + 1e-4 * slope):
+                        # a reused tangent whose step does not decrease the energy: refactorise here
+                        st = eq.evaluate(u, lam, 2)
+                        eq.factor(st)
+                        need_h, hist = True, []
+                        du = eq.solve(-st.gradient, cres)
+                        slope = float(st.gradient @ du)
+                        e_new = eq.energy(u + du, lam)
                     for _ in range(8):
-                        e_new = eq.energy(u + alpha * du, lam)
                         if np.isfinite(e_new) and e_new <= st.energy + 1e-4 * alpha * slope:
                             break
                         alpha *= 0.5
+                        e_new = eq.energy(u + alpha * du, lam)
                     else:
                         alpha = 1.0                      # no decrease found: plain Newton step
-            u = u + alpha * du
-            log.debug("  newton it %d lam %.6g rel %.2e alpha %.3g |du| %.3e tangent %s", it, lam, rel, alpha,
-                      float(np.linalg.norm(du)), "new" if need_h else "reused")
+                step = alpha * du
+            if feasible and opt.reuse_factorisation:
+                hist = ([(u, du)] + hist)[: opt.anderson]
+            log.debug("  newton it %d lam %.6g rel %.2e alpha %.3g |du| %.3e tangent %s%s", it, lam, rel, alpha,
+                      float(np.linalg.norm(du)), "new" if need_h else "reused",
+                      f" (Anderson {len(hist) - 1})" if len(hist) > 1 else "")
+            u = u + step
             prev = rel
             need_h = not opt.reuse_factorisation
         raise _Failed(f"Newton did not converge in {opt.max_iterations} iterations at load factor "
@@ -343,7 +388,7 @@ class PathSolver:
         self.eq.commit(u)
         try:
             if opt.method == "load":
-                self._load_control(sol, u)
+                self._load_control(sol, u, st0.load)
             else:
                 self._arc_length(sol, u)
         except _Failed as exc:
@@ -364,30 +409,29 @@ class PathSolver:
         pts = sorted(set([float(t) for t in self.opt.targets] + [float(self.opt.max_load)]), key=lambda v: sgn * v)
         return pts
 
-    def _load_control(self, sol, u):
+    def _load_control(self, sol, u, q):
         opt = self.opt
         lam_end = opt.max_load
         dlam = lam_end / opt.steps
         dmin = abs(lam_end) * opt.min_step
         stops = self._stop_points()
         lam = 0.0
-        u_prev, lam_prev = None, None
+        factored = True                 # the factorisation is at the current converged point
         while len(sol.path) <= opt.max_steps:
             nxt = next(s for s in stops if (s - lam) * np.sign(lam_end) > 1e-12 * abs(lam_end))
             step = dlam if abs(dlam) < abs(nxt - lam) * (1 + 1e-9) else nxt - lam
             if abs(nxt - lam - step) < 1e-9 * abs(lam_end):
                 step = nxt - lam
             lam_new = lam + step
-            if u_prev is not None:                            # secant predictor
-                u0 = u + (u - u_prev) * (step / (lam - lam_prev))
-            else:                                             # tangent predictor from the rest state
-                try:
-                    u0 = u + step * self._tangent(u, lam)
-                except SolverError:
-                    u0 = u.copy()
+            try:                                              # tangent predictor du/dlam
+                u0 = u + step * (self.eq.solve(q, self.eq.g) if factored else self._tangent(u, lam))
+                factored = True
+            except SolverError:
+                u0, factored = u.copy(), False
             try:
-                u_new, st, its, inst = self.newton(u0, lam_new)
+                u_new, st, its, inst = self.newton(u0, lam_new, factored=factored)
             except (_Failed, SolverError) as exc:
+                factored = False
                 if abs(step) / 2 < dmin:
                     raise _Failed(f"load step cut below {dmin:.3g} at load factor {lam:.6g}: {exc}") from None
                 log.info("step to %.6g failed (%s); halving", lam_new, exc)
@@ -398,7 +442,7 @@ class PathSolver:
             sol.path.append(pt)
             self.eq.commit(u_new)
             self._emit(sol, pt)
-            u_prev, lam_prev, u, lam = u, lam, u_new, lam_new
+            u, lam, q, factored = u_new, lam_new, st.load, True
             if abs(lam - lam_end) <= 1e-12 * abs(lam_end) or self._far(pt):
                 return
             # shrink only on failure (above); grow after easy steps
