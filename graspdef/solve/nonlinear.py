@@ -417,6 +417,7 @@ class PathSolver:
         stops = self._stop_points()
         lam = 0.0
         factored = True                 # the factorisation is at the current converged point
+        back = None                     # the previous converged point (u, lam)
         while len(sol.path) <= opt.max_steps:
             nxt = next(s for s in stops if (s - lam) * np.sign(lam_end) > 1e-12 * abs(lam_end))
             step = dlam if abs(dlam) < abs(nxt - lam) * (1 + 1e-9) else nxt - lam
@@ -424,8 +425,12 @@ class PathSolver:
                 step = nxt - lam
             lam_new = lam + step
             try:                                              # tangent predictor du/dlam
-                u0 = u + step * (self.eq.solve(q, self.eq.g) if factored else self._tangent(u, lam))
+                t = self.eq.solve(q, self.eq.g) if factored else self._tangent(u, lam)
                 factored = True
+                u0 = u + step * t
+                if back is not None:                          # + the curvature of the last step
+                    h = lam - back[1]
+                    u0 += (step / h) ** 2 * (back[0] - u + h * t)
             except SolverError:
                 u0, factored = u.copy(), False
             try:
@@ -442,6 +447,7 @@ class PathSolver:
             sol.path.append(pt)
             self.eq.commit(u_new)
             self._emit(sol, pt)
+            back = (u, lam)
             u, lam, q, factored = u_new, lam_new, st.load, True
             if abs(lam - lam_end) <= 1e-12 * abs(lam_end) or self._far(pt):
                 return
