@@ -212,7 +212,10 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     residual_F = fvec.sum(axis=0)
     residual_M = np.cross(shell.rest_positions, fvec).sum(axis=0)
     completed, stop_reason = True, None
-    opt = PathOptions(steps=steps or spec.steps, max_steps=40 * (steps or spec.steps), min_step=1e-3)
+    # contact paths take a few more Newton iterations per step (the barrier stiffens as the patch
+    # grows): let the step grow unless a step took more than 8
+    opt = PathOptions(steps=steps or spec.steps, max_steps=40 * (steps or spec.steps), min_step=1e-3,
+                      desired_iterations=8 if fingertips else 5)
     if analysis == "linear" and p0 > 0:
         raise ProblemError("an enclosed gas needs the nonlinear analysis (p V = const is nonlinear)")
     if analysis == "linear" and not fingertips:

@@ -139,6 +139,7 @@ def test_pads_squeeze_force_matched_no_penetration_area_grows(shell):
     assert all(p.instability == 0 for p in sol.path[1:])
 
 
+@pytest.mark.slow
 def test_small_pin_matches_point_loads_away_from_contact(shell):
     """Point-load limit (Saint-Venant's principle: statically equivalent loads give the same
     response away from where they act): a 0.1 mm pin (1.1 mm inflated by t/2) against two
