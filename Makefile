@@ -28,7 +28,8 @@ setup: $(STAMP)
 
 demo: setup
 	$(VENV)/bin/graspdef grasp tennis_ball --force 21.48 --out out/demo_tennis_ball
-	@echo "look at it: $(VENV)/bin/graspdef view out/demo_tennis_ball"
+	$(VENV)/bin/graspdef report out/demo_tennis_ball
+	@echo "look at it: out/demo_tennis_ball/report.html, or $(VENV)/bin/graspdef view out/demo_tennis_ball"
 
 test: setup
 	$(PY) -m pytest -q -m "not slow"

@@ -5,6 +5,8 @@
     graspdef grasp SCENE --force F --out DIR   MuJoCo grasp, contacts mapped onto the shell, solved
     graspdef score PREDICTION SCAN --out DIR   register a scan to a predicted surface, score it
     graspdef view RUN_DIR [RUN_DIR ...] [--host H] [--port P]   browse run folders (viser)
+    graspdef report RUN_DIR [RUN_DIR ...] [--scan SCAN] [--out FILE]   self-contained HTML report
+    graspdef sweep SPEC.toml --out DIR [--workers N | --scheduler tcp://HOST:PORT]   a grid of grasps
 
 Every error a user can cause prints one line ``graspdef: error: ...`` and exits with status 2.
 """
@@ -26,6 +28,9 @@ EPILOG = """examples:
   graspdef score out/ball/deformed.ply ycb_056_tennis_ball --out out/ball_score
   graspdef grasp tennis_ball --force 21.48 --out out/grasp_tennis_ball
   graspdef view out/plate out/rollup --port 8080
+  graspdef report out/grasp_tennis_ball                            # -> out/grasp_tennis_ball/report.html
+  graspdef sweep sweeps/smoke.toml --out out/sweep_smoke            # local, 2 worker processes
+  graspdef sweep sweeps/smoke.toml --out /shared/sweep --scheduler tcp://10.0.0.5:8786
 """
 
 
@@ -98,6 +103,17 @@ def _bench(args: argparse.Namespace) -> int:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
         Path(args.json).write_text(json.dumps(records, indent=2, default=float) + "\n")
         _progress(args, f"wrote {args.json}")
+    if args.out:
+        import json
+
+        from .geometry.io import atomic_folder
+        from .geometry.provenance import write_provenance
+
+        with atomic_folder(args.out) as tmp:
+            (tmp / "bench.json").write_text(json.dumps(records, indent=2, default=float) + "\n")
+            (tmp / "table.md").write_text(format_table(records) + "\n")
+            write_provenance(tmp, {"set": args.set, "dir": str(root), "only": args.only})
+        _progress(args, f"wrote {args.out}/ (bench.json, table.md, provenance.json)")
     failed = [r["name"] for r in records if not r.get("passed", True)]
     if failed:
         _progress(args, f"outside tolerance: {', '.join(failed)}")
@@ -130,6 +146,18 @@ def _view(args: argparse.Namespace) -> int:
     return viewer_cli(args)
 
 
+def _report(args: argparse.Namespace) -> int:
+    from .report.cli import run as report_run
+
+    return report_run(args)
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    from .sweep.cli import run_from_args
+
+    return run_from_args(args, progress=lambda m: _progress(args, m))
+
+
 def _progress(args: argparse.Namespace, msg: str) -> None:
     if not getattr(args, "quiet", False):
         print(f"[graspdef] {msg}", file=sys.stderr, flush=True)
@@ -154,6 +182,7 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--dir", help="folder with the benchmark problem files (default: the repository's "
                                   "benchmarks/, benchmarks/nonlinear/)")
     b.add_argument("--only", default="*", help="glob of benchmark names to run")
+    b.add_argument("--out", help="also write a run folder: bench.json, table.md, provenance.json")
     b.set_defaults(func=_bench)
     c = sub.add_parser("score", help="register a scan to a predicted surface and score it (score.json)",
                        description="Rigid registration (open3d ICP) of a scan to a predicted surface; writes "
@@ -179,6 +208,20 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Serve run folders as a viser page (127.0.0.1 unless --host); Ctrl-C stops it.")
     add_view_arguments(w)
     w.set_defaults(func=_view)
+    from .report.cli import add_arguments as add_report_arguments
+    rp = sub.add_parser("report", help="write a self-contained HTML report of run folders (report.html)",
+                        description="One HTML page (pictures inlined, no external URL): the deformed surface coloured "
+                                    "by displacement and by scan error, load-deflection and convergence plots, and "
+                                    "a table in the layout of Tian & Jia's Table I for several grasp runs.")
+    add_report_arguments(rp)
+    rp.set_defaults(func=_report)
+    from .sweep.cli import add_arguments as add_sweep_arguments
+    sw = sub.add_parser("sweep", help="run a grid of grasps (objects x forces x materials x contacts x meshes)",
+                        description="Run every case of a sweep spec (TOML) in parallel -- an embedded local cluster, "
+                                    "or a dask.distributed cluster with --scheduler -- into a resumable sweep folder: "
+                                    "one run folder per case, results.csv and summary.md.")
+    add_sweep_arguments(sw)
+    sw.set_defaults(func=_sweep)
     return ap
 
 

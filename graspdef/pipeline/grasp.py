@@ -34,6 +34,7 @@ import numpy as np
 from ..contact.mapping import map_contacts
 from ..errors import GraspdefError, ProblemError
 from ..geometry.io import atomic_folder, save_ply
+from ..geometry.provenance import write_provenance
 from ..problem.loads import BodyForce
 from ..problem.potentials import EnclosedGas
 from ..problem.problem import Problem
@@ -322,12 +323,16 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
         rec["convergence"]["note"] = "linear shell (rest stiffness K0) with contact: a load path of the nonlinear solver"
     if out is not None:
         out = Path(out)
-        _write(out, rec, g, sol, x_lim, u_def)
+        config = {"scene": str(scene), "force_N": force, "contact": contact, "analysis": analysis, "gas": gas,
+                  "control_faces": control_faces, "steps": steps, "E_Pa": E, "settings": dict(settings.__dict__),
+                  "shell_toml": (spec.folder / "shell.toml").read_text()}
+        _write(out, rec, g, sol, x_lim, u_def, config)
     return GraspRun(Path(out) if out is not None else None, rec)
 
 
-def _write(out: Path, rec: dict, g, sol, x_lim, u_def) -> None:
+def _write(out: Path, rec: dict, g, sol, x_lim, u_def, config: dict | None = None) -> None:
     with atomic_folder(out) as tmp:
+        write_provenance(tmp, config)
         rec = dict(rec, files={"deformed": "deformed.ply", "undeformed": "undeformed.ply", "contacts": "contacts.json"})
         (tmp / "result.json").write_text(json.dumps(rec, indent=2, default=float) + "\n")
         (tmp / "contacts.json").write_text(json.dumps({
