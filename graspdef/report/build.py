@@ -329,11 +329,14 @@ def _run_section(rr: RunReport, views, index: int) -> list[str]:
             e = np.subtract(fingers["right"]["load_point_m"], fingers["left"]["load_point_m"])
             e /= np.linalg.norm(e)
             ind = 0.5 * (probes["left"] - probes["right"]) @ e
+            ref = run.record.get("displacement_reference")
             if pt.load_factors[0] == 0 and abs(ind[0]) > 1e-3 * max(np.max(np.abs(ind)), 1e-30):
+                where = (f"result.json measures displacements from the {ref}" if ref else
+                         "the displacements in result.json are measured from the rest shape")
                 out.append(f"<div class=\"flag\">At load factor 0 the indentation per finger is already "
-                           f"{ind[0]:.3g} {rr.length_label}: the path's start state is not the rest shape "
-                           f"(e.g. the enclosed air inflates the shell before any finger force), and the "
-                           f"displacements in result.json are measured from the rest shape.</div>")
+                           f"{ind[0]:.3g} {rr.length_label} (this plot is from the rest shape): the path's start "
+                           f"state is not the rest shape (e.g. the enclosed air inflates the shell before any "
+                           f"finger force); {where}.</div>")
             plots.append(H.img(line_chart(load, {"indentation per finger": ind}, xlabel=load_label,
                                           ylabel=f"indentation per finger [{rr.length_label}]", title="load-deflection"),
                                alt="load-deflection",
