@@ -24,46 +24,6 @@ from .model import Shell
 _CHUNK = 4096
 
 
-@nb.njit(cache=True, parallel=True)
-def _hessian_blocks(N, dN, p, a1, a2, w, stride):
-    """Blocks [f, s, t, a, b] = [v_st]_x (see the module docstring); N (f|1, q, S),
-    dN (f|1, q, S, 2), p/a1/a2 (f, q, 3), w (q,) including the 1/3."""
-    nf, nq = p.shape[0], p.shape[1]
-    S = N.shape[2]
-    out = np.zeros((nf, S, S, 3, 3))
-    for f in nb.prange(nf):
-        fb = f * stride
-        for s in range(S):
-            for t in range(s + 1, S):
-                v0 = 0.0
-                v1 = 0.0
-                v2 = 0.0
-                for q in range(nq):
-                    Ns, Nt = N[fb, q, s], N[fb, q, t]
-                    d1s, d1t = dN[fb, q, s, 0], dN[fb, q, t, 0]
-                    d2s, d2t = dN[fb, q, s, 1], dN[fb, q, t, 1]
-                    ca2 = w[q] * (d1s * Nt - Ns * d1t)
-                    ca1 = w[q] * (Ns * d2t - d2s * Nt)
-                    cp = w[q] * (d2s * d1t - d1s * d2t)
-                    v0 += ca2 * a2[f, q, 0] + ca1 * a1[f, q, 0] + cp * p[f, q, 0]
-                    v1 += ca2 * a2[f, q, 1] + ca1 * a1[f, q, 1] + cp * p[f, q, 1]
-                    v2 += ca2 * a2[f, q, 2] + ca1 * a1[f, q, 2] + cp * p[f, q, 2]
-                # [v]_x and its transpose (v_ts = -v_st)
-                out[f, s, t, 0, 1] = -v2
-                out[f, s, t, 0, 2] = v1
-                out[f, s, t, 1, 0] = v2
-                out[f, s, t, 1, 2] = -v0
-                out[f, s, t, 2, 0] = -v1
-                out[f, s, t, 2, 1] = v0
-                out[f, t, s, 0, 1] = v2
-                out[f, t, s, 0, 2] = -v1
-                out[f, t, s, 1, 0] = -v2
-                out[f, t, s, 1, 2] = v0
-                out[f, t, s, 2, 0] = v1
-                out[f, t, s, 2, 1] = -v0
-    return out
-
-
 @nb.njit(cache=True)
 def _volume_terms(x, stencils, N, dN, w, nstride, order, index, base, bstride, grad, data):
     """Fused value / gradient (order >= 1) / Hessian (order 2, added into the scalar CSR ``data``
@@ -238,23 +198,20 @@ class EnclosedVolume:
         return V, grad.ravel()
 
     def _hessian_reference(self, x: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
+        """V, dV/dx and d2V/dx2 by numpy (einsum) -- the independent reference of ``_volume_terms``:
+        block (s, t) = [v_st]_x with v_st as in the module docstring."""
         w = self.shell.basis.qweights / 3.0
-        V = 0.0
-        grad = np.zeros((self.shell.n_control, 3))
+        V, grad = self._gradient_reference(x)
         blocks: list[list] = [[] for _ in self.shell.basis.groups]
         gi_of = {id(g): i for i, g in enumerate(self.shell.basis.groups)}
         for g, sl, N, dN in self._chunks():
             N, dN, p, a1, a2 = self._fields(g, sl, N, dN, x)
-            m = np.cross(a1, a2)
-            V += float(np.einsum("fqd,fqd,q->", p, m, w))
             d1, d2 = dN[..., 0], dN[..., 1]
-            ge = (np.einsum("fqs,fqd,q->fsd", N, m, w)
-                  + np.einsum("fqs,fqd,q->fsd", d1, np.cross(a2, p), w)
-                  + np.einsum("fqs,fqd,q->fsd", d2, np.cross(p, a1), w))
-            np.add.at(grad, g.stencils[sl], ge)
-            Nr = g.N if g.N.shape[0] == 1 else g.N[sl]
-            dNr = g.dN if g.dN.shape[0] == 1 else g.dN[sl]
-            blk = _hessian_blocks(np.ascontiguousarray(Nr), np.ascontiguousarray(dNr), np.ascontiguousarray(p),
-                                  np.ascontiguousarray(a1), np.ascontiguousarray(a2), w, 0 if g.N.shape[0] == 1 else 1)
+            v = (np.einsum("q,fqs,fqt,fqd->fstd", w, d1, N, a2) - np.einsum("q,fqs,fqt,fqd->fstd", w, N, d1, a2)
+                 + np.einsum("q,fqs,fqt,fqd->fstd", w, N, d2, a1) - np.einsum("q,fqs,fqt,fqd->fstd", w, d2, N, a1)
+                 + np.einsum("q,fqs,fqt,fqd->fstd", w, d2, d1, p) - np.einsum("q,fqs,fqt,fqd->fstd", w, d1, d2, p))
+            blk = np.zeros(v.shape[:3] + (3, 3))
+            blk[..., 0, 1], blk[..., 0, 2], blk[..., 1, 2] = -v[..., 2], v[..., 1], -v[..., 0]
+            blk[..., 1, 0], blk[..., 2, 0], blk[..., 2, 1] = v[..., 2], -v[..., 1], v[..., 0]
             blocks[gi_of[id(g)]].append((sl, blk))
-        return V, grad.ravel(), self.pattern.assemble(blocks)
+        return V, grad, self.pattern.assemble(blocks)
