@@ -77,21 +77,11 @@ steps = 3
 
 def solve_into(folder: Path, text: str) -> Path:
     """``graspdef solve`` of a problem text into ``folder`` (the real writer)."""
-    from graspdef.problem.config import load_problem
-    from graspdef.solve.output import write_run
+    from graspdef.cli import main
 
     src = folder.parent / f"{folder.name}.toml"
     src.write_text(text)
-    spec = load_problem(src)
-    if spec.solver.get("type") == "nonlinear":
-        from graspdef.solve.nonlinear import path_options, solve_nonlinear
-
-        sol = solve_nonlinear(spec.problem, path_options(spec.solver))
-    else:
-        from graspdef.solve.linear import solve_linear
-
-        sol = solve_linear(spec.problem)
-    write_run(folder, spec, sol, text)
+    assert main(["-q", "solve", str(src), "--out", str(folder)]) == 0
     return folder
 
 

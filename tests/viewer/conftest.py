@@ -77,21 +77,11 @@ steps = 4
 
 
 def _solve(folder: Path, text: str, path_u: bool = True) -> Path:
-    from graspdef.problem.config import load_problem
-    from graspdef.solve.output import write_run
+    from graspdef.cli import main
 
     src = folder.parent / f"{folder.name}.toml"
     src.write_text(text)
-    spec = load_problem(src)
-    if spec.solver.get("type") == "nonlinear":
-        from graspdef.solve.nonlinear import path_options, solve_nonlinear
-
-        sol = solve_nonlinear(spec.problem, path_options(spec.solver))
-    else:
-        from graspdef.solve.linear import solve_linear
-
-        sol = solve_linear(spec.problem)
-    write_run(folder, spec, sol, text)                 # nonlinear runs include path_u.npz
+    assert main(["-q", "solve", str(src), "--out", str(folder)]) == 0
     if not path_u:
         (folder / "path_u.npz").unlink(missing_ok=True)     # an older run folder, without it
     return folder
