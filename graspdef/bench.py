@@ -20,6 +20,27 @@ from .solve.linear import solve_linear
 from .solve.output import result_record
 
 
+def ring_pinched_sphere(shell, R: float, a: float, n_ring: int, force: float):
+    """A free sphere of radius R (``shell``) squeezed by two rings of ``n_ring`` point loads (total
+    ``force`` per ring, axial, towards the equator) at the polar circles of radius a R -- the 3-D
+    counterpart of the thesis's ring-loaded ball (scripts/crosscheck_axisym_3d.py,
+    scripts/synthetic_scan_study.py); probes "top" and "bottom" at the poles."""
+    from .problem.loads import PointLoad
+    from .problem.problem import Problem
+    from .problem.supports import RigidModes
+
+    pr = Problem(shell, [], [RigidModes()])
+    zc = np.sqrt(R ** 2 - (a * R) ** 2)
+    for s in (1.0, -1.0):
+        for k in range(n_ring):
+            th = 2 * np.pi * (k + 0.5) / n_ring
+            p = pr.locate((a * R * np.cos(th), a * R * np.sin(th), s * zc))
+            pr.loads.append(PointLoad(p.face, p.bary, (0.0, 0.0, -s * force / n_ring)))
+    pr.probes["top"] = pr.locate((0.0, 0.0, R))
+    pr.probes["bottom"] = pr.locate((0.0, 0.0, -R))
+    return pr
+
+
 def quantity(rec: dict, expr: str) -> float:
     """Evaluate a reference quantity expression on a result record."""
     sign = -1.0 if expr.startswith("-") else 1.0

@@ -172,26 +172,16 @@ def shell_material():
 def shell3d_pinched(subdivisions: int, R_over_t: float, loads, a: float = RING_RADIUS, n_ring: int = 64):
     """Apex displacement / R (half the change of the pole-to-pole distance) of the 3-D sphere at
     each F/(C1 t^2) in ``loads``; returns (values, info)."""
+    from graspdef.bench import ring_pinched_sphere
     from graspdef.geometry import sphere
-    from graspdef.problem.loads import PointLoad
-    from graspdef.problem.problem import Problem
-    from graspdef.problem.supports import RigidModes
     from graspdef.shell.model import Shell
     from graspdef.solve.nonlinear import PathOptions, solve_nonlinear
     t0 = time.perf_counter()
     t = R / R_over_t
     m = sphere(R, subdivisions)
     sh = Shell(m.vertices, m.faces, shell_material(), t)
-    pr = Problem(sh, [], [RigidModes()])
     Fmax = max(loads) * t ** 2
-    zc = np.sqrt(R ** 2 - (a * R) ** 2)
-    for s in (1.0, -1.0):
-        for k in range(n_ring):
-            th = 2 * np.pi * (k + 0.5) / n_ring
-            p = pr.locate((a * R * np.cos(th), a * R * np.sin(th), s * zc))
-            pr.loads.append(PointLoad(p.face, p.bary, (0.0, 0.0, -s * Fmax / n_ring)))
-    pr.probes["top"] = pr.locate((0.0, 0.0, R))
-    pr.probes["bottom"] = pr.locate((0.0, 0.0, -R))
+    pr = ring_pinched_sphere(sh, R, a, n_ring, Fmax)
     factors = tuple(L * t ** 2 / Fmax for L in loads)
     sol = solve_nonlinear(pr, PathOptions(steps=4, targets=factors))
     out = []

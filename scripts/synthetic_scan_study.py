@@ -142,10 +142,8 @@ def limit_surface_map(faces: np.ndarray, n_control: int, min_vertices: int = 10_
 
 def predictions(subdivisions: int, levels, n_ring: int = N_RING) -> dict:
     """Nonlinear and linear limit surfaces [m] of the 3-D shell at each level, and the rest one."""
+    from graspdef.bench import ring_pinched_sphere
     from graspdef.geometry import TriMesh, sphere
-    from graspdef.problem.loads import PointLoad
-    from graspdef.problem.problem import Problem
-    from graspdef.problem.supports import RigidModes
     from graspdef.shell.hyperelastic import MooneyRivlin
     from graspdef.shell.model import Shell
     from graspdef.solve.linear import solve_linear
@@ -154,16 +152,8 @@ def predictions(subdivisions: int, levels, n_ring: int = N_RING) -> dict:
     R, t = 1.0, 1.0 / R_OVER_T
     mesh = sphere(R, subdivisions)
     shell = Shell(mesh.vertices, mesh.faces, MooneyRivlin(1.0, GAMMA), t)
-    pr = Problem(shell, [], [RigidModes()])
     Fmax = max(levels) * t ** 2
-    zc = np.sqrt(R ** 2 - (RING * R) ** 2)
-    for sgn in (1.0, -1.0):
-        for k in range(n_ring):
-            th = 2 * np.pi * (k + 0.5) / n_ring
-            p = pr.locate((RING * R * np.cos(th), RING * R * np.sin(th), sgn * zc))
-            pr.loads.append(PointLoad(p.face, p.bary, (0.0, 0.0, -sgn * Fmax / n_ring)))
-    pr.probes["top"] = pr.locate((0.0, 0.0, R))
-    pr.probes["bottom"] = pr.locate((0.0, 0.0, -R))
+    pr = ring_pinched_sphere(shell, R, RING, n_ring, Fmax)
     factors = [L * t ** 2 / Fmax for L in levels]
     t0 = time.perf_counter()
     lin = solve_linear(pr)
