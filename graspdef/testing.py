@@ -1,4 +1,5 @@
-"""Verification helpers shared by graspdef's tests and usable by anyone extending it (numpy only)."""
+"""Verification helpers shared by graspdef's tests and usable by anyone extending it (numpy; the
+browser helper imports selenium when called)."""
 from __future__ import annotations
 
 import numpy as np
@@ -30,3 +31,31 @@ def assert_fd_rate(exact, fd_h, fd_h2, scale=None, floor=FD_FLOOR, what="derivat
         f"at O(h^2): ratios {np.sort(ratio[bad])[:8]}, errors {np.sort(e2[~small][bad])[-4:]} "
         f"(scale {scale:.3e})")
     return e2.max() / scale, int(ratio.size)
+
+
+#: Debian chromium's flags for headless screenshots (../shared/MEASURED.md, viser)
+CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                  "--disable-component-update", "--disable-sync", "--no-first-run"]
+
+
+def headless_chromium(profile_dir, window: str = "1200,800"):
+    """A selenium driver of Debian's headless chromium (profile in ``profile_dir``), for the
+    browser acceptance tests and the screenshot scripts.  A missing browser is a set-up error
+    (AssertionError naming the packages), not a skip: ``make test`` installs them."""
+    import shutil
+
+    from selenium import webdriver
+    from selenium.webdriver.chrome.options import Options
+    from selenium.webdriver.chrome.service import Service
+
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    chromedriver = shutil.which("chromedriver")
+    assert chromium and chromedriver, ("Debian's chromium and chromium-driver are missing: run 'make test' as root "
+                                       "(it apt-installs them) or 'apt-get install chromium chromium-driver'")
+    opts = Options()
+    opts.binary_location = chromium
+    for f in CHROMIUM_FLAGS + [f"--window-size={window}", f"--user-data-dir={profile_dir}"]:
+        opts.add_argument(f)
+    driver = webdriver.Chrome(options=opts, service=Service(chromedriver))
+    driver.set_page_load_timeout(60)
+    return driver

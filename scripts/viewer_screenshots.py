@@ -12,7 +12,6 @@ from __future__ import annotations
 import argparse
 import io
 import json
-import shutil
 import time
 from pathlib import Path
 
@@ -103,17 +102,9 @@ def synthetic_score(run: Path) -> None:
 
 
 def browser(width: int, height: int, profile: Path):
-    from selenium import webdriver
-    from selenium.webdriver.chrome.options import Options
-    from selenium.webdriver.chrome.service import Service
+    from graspdef.testing import headless_chromium
 
-    o = Options()
-    o.binary_location = shutil.which("chromium")
-    for a in ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-              "--disable-component-update", "--disable-sync", "--no-first-run", f"--window-size={width},{height}",
-              f"--user-data-dir={profile}"]:
-        o.add_argument(a)
-    return webdriver.Chrome(options=o, service=Service(shutil.which("chromedriver")))
+    return headless_chromium(profile, window=f"{width},{height}")
 
 
 def save_small(driver, path: Path) -> None:

@@ -5,33 +5,16 @@ screenshot has content (many colours, colour-map hues, not a blank page).  Chrom
 from __future__ import annotations
 
 import io
-import shutil
 
 import numpy as np
 import pytest
 
-from selenium import webdriver
-
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-CHROMEDRIVER = shutil.which("chromedriver")
-FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-         "--disable-component-update", "--disable-sync", "--no-first-run", "--window-size=1280,2400"]
-
+from graspdef.testing import headless_chromium
 
 @pytest.fixture
 def browser(tmp_path):
-    """A missing browser is a set-up error, not a skip (make test installs it)."""
-    assert CHROMIUM and CHROMEDRIVER, ("Debian's chromium and chromium-driver are missing: run 'make test' as root "
-                                       "(it apt-installs them) or 'apt-get install chromium chromium-driver'")
-    from selenium.webdriver.chrome.options import Options
-    from selenium.webdriver.chrome.service import Service
-
-    opts = Options()
-    opts.binary_location = CHROMIUM
-    for f in FLAGS + [f"--user-data-dir={tmp_path / 'profile'}"]:
-        opts.add_argument(f)
-    driver = webdriver.Chrome(options=opts, service=Service(CHROMEDRIVER))
-    driver.set_page_load_timeout(60)
+    """Debian's headless chromium (a missing browser is a set-up error, not a skip)."""
+    driver = headless_chromium(tmp_path / "profile", window="1280,2400")
     yield driver
     driver.quit()
 

@@ -2,47 +2,26 @@
 page, the screenshot shows the rendered 3-D scene (pixel content, not a blank canvas), and
 moving the load-path slider in the browser changes the mesh (server side and a second screenshot).
 
-Needs the Debian packages chromium and chromium-driver and the selenium package; skipped
-(with the reason) when they are missing.  Chromium's flags: ../shared/MEASURED.md (viser)."""
+Needs the Debian packages chromium and chromium-driver and the selenium package; a missing
+browser is a set-up error (graspdef.testing.headless_chromium), not a skip.  Chromium's flags: ../shared/MEASURED.md (viser)."""
 from __future__ import annotations
 
 import io
-import shutil
 import threading
 import time
 
 import numpy as np
 import pytest
 
-from selenium import webdriver
-
+from graspdef.testing import headless_chromium
 from graspdef.viewer.layers import VIRIDIS
 from graspdef.viewer.server import Viewer
-
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-CHROMEDRIVER = shutil.which("chromedriver")
-
-@pytest.fixture(autouse=True)
-def _chromium_installed():
-    """The acceptance test needs a real browser: a missing one is a set-up error, not a skip."""
-    assert CHROMIUM and CHROMEDRIVER, ("Debian's chromium and chromium-driver are missing: run 'make test' as root "
-                                       "(it apt-installs them) or 'apt-get install chromium chromium-driver'")
-
-FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-         "--disable-component-update", "--disable-sync", "--no-first-run", "--window-size=1200,800"]
 
 
 @pytest.fixture
 def browser(tmp_path):
-    from selenium.webdriver.chrome.options import Options
-    from selenium.webdriver.chrome.service import Service
-
-    opts = Options()
-    opts.binary_location = CHROMIUM
-    for f in FLAGS + [f"--user-data-dir={tmp_path / 'profile'}"]:
-        opts.add_argument(f)
-    driver = webdriver.Chrome(options=opts, service=Service(CHROMEDRIVER))
-    driver.set_page_load_timeout(60)
+    """Debian's headless chromium (a missing browser is a set-up error, not a skip)."""
+    driver = headless_chromium(tmp_path / "profile", window="1200,800")
     yield driver
     driver.quit()
 
