@@ -123,9 +123,9 @@ class EnclosedGas:
         if order < 2:
             V, g = self._vol.gradient(x)
             return PotentialTerms(self._value(V), -self.gauge_pressure(V) * g, None)
-        V = self._vol.value(x)
+        V, g, H = self._vol.hessian(x)
         pg = self.gauge_pressure(V)
-        V, g, H = self._vol.hessian(x, scale=-pg)
+        H.data *= -pg
         c = (self.p_atm + self.p0) * self.V0 / V ** 2
         return PotentialTerms(self._value(V), -pg * g, H, [(c, g)])
 

@@ -131,7 +131,11 @@ class BlockPattern:
         for a in range(3):
             pos = (self.base[:, None] + a * self.stride[:, None] + np.arange(3)).ravel()
             idx[pos] = cols3
-        self.scalar_indices = idx
+        # index arrays in the dtype scipy keeps (int32 when it fits), so that every CSR matrix on
+        # this pattern shares them: sums on the same pattern are then cheap (see solve.equilibrium)
+        itype = np.int32 if 9 * self.nnzb < 2 ** 31 else np.int64
+        self.scalar_indices = idx.astype(itype)
+        self.scalar_indptr = self.scalar_indptr.astype(itype)
 
     def assemble(self, group_blocks: list[list[tuple[np.ndarray, np.ndarray]]]) -> sp.csr_matrix:
         """Sum element blocks into a CSR matrix; ``group_blocks[g]`` lists (face_slice, blocks
@@ -143,6 +147,16 @@ class BlockPattern:
                 S = blk.shape[1]
                 scatter_blocks(data, m[sl.start * S * S: sl.stop * S * S], blk, self.base, self.stride)
         return sp.csr_matrix((data, self.scalar_indices, self.scalar_indptr), shape=(3 * self.n, 3 * self.n))
+
+
+def block_pattern(shell: Shell) -> BlockPattern:
+    """The shell's :class:`BlockPattern`, built once per (immutable) shell and kept with it, so
+    that the energy, the enclosed volume and the other terms of one problem share it."""
+    pat = shell.__dict__.get("_block_pattern")
+    if pat is None:
+        pat = BlockPattern(shell)
+        shell.__dict__["_block_pattern"] = pat
+    return pat
 
 
 class ShellEnergy:
@@ -157,7 +171,7 @@ class ShellEnergy:
     @property
     def pattern(self) -> BlockPattern:
         if self._pattern is None:
-            self._pattern = BlockPattern(self.shell)
+            self._pattern = block_pattern(self.shell)
         return self._pattern
 
     def _chunks(self):

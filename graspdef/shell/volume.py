@@ -18,7 +18,7 @@ import numba as nb
 import numpy as np
 import scipy.sparse as sp
 
-from .energy import BlockPattern
+from .energy import BlockPattern, block_pattern
 from .model import Shell
 
 _CHUNK = 4096
@@ -116,7 +116,7 @@ class EnclosedVolume:
     @property
     def pattern(self) -> BlockPattern:
         if self._pattern is None:
-            self._pattern = BlockPattern(self.shell)
+            self._pattern = block_pattern(self.shell)
         return self._pattern
 
     def _chunks(self):

@@ -101,6 +101,40 @@ def kkt_matrix(K: sp.spmatrix, C: sp.spmatrix) -> tuple[sp.csr_matrix, float]:
     return A, scale
 
 
+class _UpperMap:
+    """Where K's upper-triangle entries and C^T's entries go in :func:`kkt_upper`'s matrix, for
+    one sparsity pattern of K: later matrices on the same pattern (Newton iterations) only
+    gather their values."""
+
+    def __init__(self, K: sp.csr_matrix, C: sp.spmatrix):
+        self.indptr, self.indices = K.indptr, K.indices
+        U = kkt_upper(sp.csr_matrix((np.arange(1, K.nnz + 1, dtype=float), K.indices, K.indptr), shape=K.shape),
+                      C, 1.0)
+        n = K.shape[0]
+        self.n = n
+        self.shape = U.shape
+        self.U_indptr, self.U_indices = U.indptr, U.indices
+        is_k = U.indices < n
+        self.pos_k = np.flatnonzero(is_k)
+        self.src_k = U.data[is_k].astype(np.int64) - 1          # K.data index of each upper entry
+        self.pos_c = np.flatnonzero(~is_k & (U.data != 0))
+        self.c_data = U.data[self.pos_c]
+
+    def matches(self, K: sp.csr_matrix) -> bool:
+        same = [a is b or (a.shape == b.shape and a.dtype == b.dtype and a.strides == b.strides
+                           and a.ctypes.data == b.ctypes.data)
+                for a, b in ((K.indptr, self.indptr), (K.indices, self.indices))]
+        return all(same) or (
+            K.nnz == self.indices.size and np.array_equal(K.indptr, self.indptr)
+            and np.array_equal(K.indices, self.indices))
+
+    def upper(self, K: sp.csr_matrix, scale: float) -> sp.csr_matrix:
+        data = np.zeros(self.U_indices.size)
+        data[self.pos_k] = K.data[self.src_k]
+        data[self.pos_c] = scale * self.c_data
+        return sp.csr_matrix((data, self.U_indices, self.U_indptr), shape=self.shape)
+
+
 def kkt_upper(K: sp.spmatrix, C: sp.spmatrix, scale: float) -> sp.csr_matrix:
     """Upper triangle of the KKT matrix with an explicit (zero) diagonal in the constraint block,
     as PARDISO's symmetric modes want it; built without forming the full matrix."""
@@ -149,6 +183,7 @@ class KKTSystem:
         self.m = self.C.shape[0]
         self._solver = None
         self._pattern = None
+        self._map: _UpperMap | None = None
         self._lu = None
         self.n_negative: int | None = None
         self.perturbed = 0
@@ -177,7 +212,12 @@ class KKTSystem:
         if self.backend == "pardiso":
             import pypardiso
 
-            U = kkt_upper(self.K, self.C, self.scale)
+            K = self.K
+            if not K.has_sorted_indices:
+                K = K.sorted_indices()
+            if self._map is None or not self._map.matches(K):
+                self._map = _UpperMap(K, self.C)
+            U = self._map.upper(K, self.scale)
             pattern = (U.shape, U.nnz, hash(U.indices[:: max(1, U.nnz // 4096)].tobytes()))
             if self._solver is None:
                 self._solver = _new_pardiso(-2)
