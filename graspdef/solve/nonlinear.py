@@ -62,6 +62,8 @@ class PathOptions:
     reuse_factorisation, reuse_ratio : in load control, reuse a factorised tangent (the previous
         converged point's) while the residual contracts by reuse_ratio per iteration (modified Newton)
     anderson : depth of the Anderson mixing of the modified-Newton corrections (0: plain)
+    inertia_rtol : the stability of a point is the inertia of a Hessian factorised within this
+        relative residual of it (0: at the converged state itself); see :meth:`PathSolver.newton`
     refine_critical : arc-length bisections that narrow a change of stability down (each halves
         the bracket; the load factor at a limit point is then accurate to O(bracket^2))
     """
@@ -80,8 +82,9 @@ class PathOptions:
     max_probe_displacement: float | None = None
     refine_critical: int = 12
     reuse_factorisation: bool = True
-    reuse_ratio: float = 0.5
+    reuse_ratio: float = 0.9
     anderson: int = 5
+    inertia_rtol: float = 1e-4
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -98,6 +101,8 @@ class PathOptions:
             raise ProblemError(f"min_step must lie in (0, 1), got {self.min_step!r}")
         if not isinstance(self.anderson, (int, np.integer)) or self.anderson < 0:
             raise ProblemError(f"anderson must be a non-negative integer, got {self.anderson!r}")
+        if not (0 <= self.inertia_rtol < 1e-2):
+            raise ProblemError(f"inertia_rtol must lie in [0, 1e-2), got {self.inertia_rtol!r}")
         if not (0 < self.reuse_ratio < 1):
             raise ProblemError(f"reuse_ratio must lie in (0, 1), got {self.reuse_ratio!r}")
         if not self.max_growth > 1:
@@ -197,11 +202,14 @@ class PathSolver:
         self.eq = Equilibrium(problem, backend)
         self.gas = [p for p in self.eq.potentials if isinstance(p, EnclosedGas)]
         self.q_norm = 0.0
+        self.inertia_residual = 0.0
 
     # ---------------------------------------------------------------------------------------
     def _record(self, u, lam, state, its, inst, kind="step") -> PathPoint:
         x_u = u.reshape(-1, 3)
         pt = PathPoint(float(lam), x_u.copy(), float(state.energy), int(its), inst, kind)
+        # relative residual of the iterate whose factorisation gave the stability (0: this point)
+        pt.extra["inertia_residual"] = float(self.inertia_residual)
         if self.eq.m and np.any(self.eq.g):               # reactions of prescribed displacements
             _, mu = self.eq.projected_residual(state.gradient)
             for i in np.flatnonzero(self.eq.g):
@@ -238,15 +246,22 @@ class PathSolver:
         convergence of the stale tangent into nearly the Newton rate.  A fresh tangent is
         factorised when the contraction is poor (every iteration when ``reuse_factorisation``
         is off).  ``factored``: the current factorisation (of a nearby state, e.g. the previous
-        converged point) may serve from the first iteration.  The converged state is always
-        factorised itself: its inertia is the reported stability, and it is the tangent of the
-        next step's predictor and iterations."""
+        converged point) may serve from the first iteration.
+
+        The reported stability is the inertia of a Hessian factorised at the converged state or
+        at an iterate of this solve whose relative residual is at most ``inertia_rtol`` (as in
+        the arc-length corrector and in most codes: the last iterate's tangent): once the
+        residual falls below it on a tangent from elsewhere, the tangent is refreshed there, and
+        that factorisation finishes the iterations, gives the stability and is the next step's
+        predictor and tangent.  With ``inertia_rtol = 0`` the converged state itself is always
+        factorised (one more factorisation per point)."""
         eq, opt = self.eq, self.opt
         u = u0.copy()
         first = prev = None
         need_h = not (factored and opt.reuse_factorisation)
         hist: list[tuple[np.ndarray, np.ndarray]] = []      # (u_k, du_k) since the factorisation
         back = None                                          # state before an Anderson step
+        near = None                 # inertia of a factorisation at an iterate within inertia_rtol
         for it in range(opt.max_iterations + 1):
             st = eq.evaluate(u, lam, 2 if need_h else 1)
             if not np.isfinite(st.energy) or not np.all(np.isfinite(st.gradient)):
@@ -255,20 +270,28 @@ class PathSolver:
                 (u, st), back, hist = back, None, []       # e.g. through a contact barrier: plain step
             ok, rel = self._converged(st, u, lam)
             if ok:
+                if near is not None:
+                    self.inertia_residual = near[1]
+                    return u, st, it, near[0]
                 if st.hessian is None:
                     st = eq.evaluate(u, lam, 2)
                 inst = eq.factor(st)
+                self.inertia_residual = 0.0
                 return u, st, it, inst
             if it == opt.max_iterations:
                 break
             first = rel if first is None else first
             if it >= 8 and rel > 10 * first:
                 raise _Failed(f"Newton diverges at load factor {lam:.6g} (residual {rel:.2e})")
-            if not need_h and prev is not None and rel > opt.reuse_ratio * prev:
-                st = eq.evaluate(u, lam, 2)                 # poor contraction: fresh tangent
+            if not need_h and (near is None and rel <= opt.inertia_rtol
+                               or prev is not None and rel > opt.reuse_ratio * prev):
+                # nearly converged on a tangent from elsewhere (its factorisation at this iterate
+                # gives the stability and the final iterations), or poor contraction: fresh tangent
+                st = eq.evaluate(u, lam, 2)
                 need_h = True
             if need_h:
-                eq.factor(st)
+                inst = eq.factor(st)
+                near = (inst, rel) if rel <= opt.inertia_rtol else None
                 hist = []
             cres = eq.constraint_residual(u, lam)
             du = eq.solve(-st.gradient, cres)
@@ -552,8 +575,9 @@ class PathSolver:
                 raise _Failed(f"non-finite state near load factor {ln:.6g}")
             ok, rel = self._converged(st, un, ln)
             if ok and it > 1:
+                self.inertia_residual = inst_rel
                 return un, ln, it - 1, st, inst
-            inst = eq.factor(st)
+            inst, inst_rel = eq.factor(st), rel
             cres = eq.constraint_residual(un, ln)
             sols = eq.solve(np.stack([-st.gradient, st.load], 1), np.stack([cres, eq.g], 1))
             dR, dF = sols[:, 0], sols[:, 1]

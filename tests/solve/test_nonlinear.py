@@ -230,6 +230,37 @@ def test_euler_buckling_is_detected_as_a_bifurcation():
     assert lo * 1.5 <= 1.02 and hi * 1.5 >= 0.98, cps[0]
 
 
+def test_reported_stability_is_the_inertia_at_the_converged_point():
+    """The stability of a point may come from the tangent factorised at a late Newton iterate
+    (within inertia_rtol of equilibrium, saving a factorisation per point); it must equal the
+    inertia of the Hessian factorised at the converged point itself, on both sides of the Euler
+    load of a compressed strip (Timoshenko & Gere: P = pi^2 EI / L^2; t/L = 1/20, so the
+    straight path is nonlinear and Newton needs several iterations); and the same end state
+    as with a factorisation at every converged point (inertia_rtol = 0)."""
+    L, b, t, E = 4.0, 0.5, 0.2, 1e6
+    m = rectangle(L, b, 32, 4, center=(L / 2, b / 2))
+    sh = Shell(m.vertices, m.faces, LinearElastic(E, 0.0), t)
+    ends = lambda x: (np.abs(x[:, 0]) < 1e-9) | (np.abs(x[:, 0] - L) < 1e-9)  # noqa: E731
+    pr = Problem(sh, [], [EdgeSupport("diaphragm", ends, normal=(1, 0, 0))])
+    a = pr.locate((0.0, 0.0, 0))
+    pr.supports.append(PointSupport(a.face, a.bary, ((1, 0, 0),)))
+    P_e = np.pi ** 2 * E * b * t ** 3 / 12 / L ** 2
+    pr.loads.append(EdgeLoad(lambda x: np.abs(x[:, 0] - L) < 1e-9, (-1.5 * P_e / b, 0, 0)))
+    near = solve_nonlinear(pr, PathOptions(steps=6, inertia_rtol=1e-4))
+    exact = solve_nonlinear(pr, PathOptions(steps=6, inertia_rtol=0.0))
+    eq = Equilibrium(pr)
+    reported = [p.instability for p in near.path]
+    at_point = [eq.factor(eq.evaluate(p.u.ravel(), p.load_factor, 2)) for p in near.path]
+    eq.close()
+    used = [p.extra["inertia_residual"] for p in near.path]
+    assert any(0 < r <= 1e-4 for r in used), used                     # the late-iterate path is exercised
+    assert all(p.extra["inertia_residual"] == 0 for p in exact.path)
+    assert reported == at_point
+    assert reported[0] == 0 and reported[-1] == 1                       # stable before, unstable after P_e
+    assert exact.path[-1].instability == 1
+    assert np.allclose(exact.u, near.u, rtol=0, atol=1e-7 * np.abs(near.u).max())
+
+
 def test_a_path_that_cannot_continue_keeps_its_converged_part():
     """max_steps too small: PathStopped with the converged points (all converged), no result."""
     pr = Problem(*_cantilever(), [EdgeSupport("clamped", lambda x: np.abs(x[:, 0]) < 1e-9)])
@@ -257,6 +288,10 @@ def test_bad_inputs_are_refused():
         PathOptions(method="riks")
     with pytest.raises(ProblemError, match="targets"):
         PathOptions(targets=(1.5,))
+    with pytest.raises(ProblemError, match="inertia_rtol"):
+        PathOptions(inertia_rtol=0.1)
+    with pytest.raises(ProblemError, match="reuse_ratio"):
+        PathOptions(reuse_ratio=1.0)
     with pytest.raises(ProblemError, match="no load"):
         solve_nonlinear(Problem(sh, [], sup))
     with pytest.raises(ProblemError, match="absolute pressure"):
