@@ -37,9 +37,11 @@ def _same(a: np.ndarray, b: np.ndarray) -> bool:
 
 
 def _add(A: sp.spmatrix, B: sp.spmatrix) -> sp.csr_matrix:
-    """A + B; entry by entry when both are CSR on the same structure (the shell pattern)."""
+    """A + B, overwriting A (a matrix the caller owns) when both are CSR on the same index
+    arrays (the shell's shared pattern); else entry by entry on an equal structure, or scipy's sum."""
     if sp.isspmatrix_csr(A) and sp.isspmatrix_csr(B) and _same(A.indices, B.indices) and _same(A.indptr, B.indptr):
-        return sp.csr_matrix((A.data + B.data, A.indices, A.indptr), shape=A.shape)
+        A.data += B.data
+        return A
     if (sp.isspmatrix_csr(A) and sp.isspmatrix_csr(B) and A.nnz == B.nnz and A.has_sorted_indices
             and B.has_sorted_indices and np.array_equal(A.indptr, B.indptr) and np.array_equal(A.indices, B.indices)):
         return sp.csr_matrix((A.data + B.data, A.indices, A.indptr), shape=A.shape)
