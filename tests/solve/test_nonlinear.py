@@ -210,11 +210,10 @@ def _cantilever():
     return Shell(m.vertices, m.faces, LinearElastic(1e5, 0.0), 0.1), []
 
 
-def test_euler_buckling_is_detected_as_a_bifurcation():
-    """A simply supported strip under axial compression stays straight; its stability changes
-    at the Euler load P = pi^2 EI / L^2 (Timoshenko & Gere), detected from the inertia of the
-    tangent and reported as a bifurcation within 2 %."""
-    L, b, t, E = 4.0, 0.5, 0.02, 1e6
+def _compressed_strip(t: float) -> Problem:
+    """A strip L = 4, b = 0.5, E = 1e6 (nu = 0) of thickness t, simply supported at both ends
+    (diaphragms) and compressed by 1.5 times its Euler load P_e = pi^2 E b t^3 / (12 L^2)."""
+    L, b, E = 4.0, 0.5, 1e6
     m = rectangle(L, b, 32, 4, center=(L / 2, b / 2))
     sh = Shell(m.vertices, m.faces, LinearElastic(E, 0.0), t)
     ends = lambda x: (np.abs(x[:, 0]) < 1e-9) | (np.abs(x[:, 0] - L) < 1e-9)  # noqa: E731
@@ -223,6 +222,14 @@ def test_euler_buckling_is_detected_as_a_bifurcation():
     pr.supports.append(PointSupport(a.face, a.bary, ((1, 0, 0),)))
     P_e = np.pi ** 2 * E * b * t ** 3 / 12 / L ** 2
     pr.loads.append(EdgeLoad(lambda x: np.abs(x[:, 0] - L) < 1e-9, (-1.5 * P_e / b, 0, 0)))
+    return pr
+
+
+def test_euler_buckling_is_detected_as_a_bifurcation():
+    """A simply supported strip under axial compression stays straight; its stability changes
+    at the Euler load P = pi^2 EI / L^2 (Timoshenko & Gere), detected from the inertia of the
+    tangent and reported as a bifurcation within 2 %."""
+    pr = _compressed_strip(0.02)
     sol = solve_nonlinear(pr, PathOptions(steps=15, max_steps=60), allow_partial=True)
     cps = [c for c in sol.critical_points if c["kind"] == "bifurcation point"]
     assert cps, sol.critical_points
@@ -237,15 +244,7 @@ def test_reported_stability_is_the_inertia_at_the_converged_point():
     load of a compressed strip (Timoshenko & Gere: P = pi^2 EI / L^2; t/L = 1/20, so the
     straight path is nonlinear and Newton needs several iterations); and the same end state
     as with a factorisation at every converged point (inertia_rtol = 0)."""
-    L, b, t, E = 4.0, 0.5, 0.2, 1e6
-    m = rectangle(L, b, 32, 4, center=(L / 2, b / 2))
-    sh = Shell(m.vertices, m.faces, LinearElastic(E, 0.0), t)
-    ends = lambda x: (np.abs(x[:, 0]) < 1e-9) | (np.abs(x[:, 0] - L) < 1e-9)  # noqa: E731
-    pr = Problem(sh, [], [EdgeSupport("diaphragm", ends, normal=(1, 0, 0))])
-    a = pr.locate((0.0, 0.0, 0))
-    pr.supports.append(PointSupport(a.face, a.bary, ((1, 0, 0),)))
-    P_e = np.pi ** 2 * E * b * t ** 3 / 12 / L ** 2
-    pr.loads.append(EdgeLoad(lambda x: np.abs(x[:, 0] - L) < 1e-9, (-1.5 * P_e / b, 0, 0)))
+    pr = _compressed_strip(0.2)
     near = solve_nonlinear(pr, PathOptions(steps=6, inertia_rtol=1e-4))
     exact = solve_nonlinear(pr, PathOptions(steps=6, inertia_rtol=0.0))
     eq = Equilibrium(pr)
