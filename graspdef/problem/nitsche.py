@@ -1,9 +1,17 @@
 """Nitsche's method for rotation-fixed edges (clamped, symmetry) at finite deformation.
 
-At each Gauss point of such an edge the rotation measure is theta = n0 . du/dnu with the rest
-normal n0 and the rest outward conormal nu.  It is linear in the displacement and *exact* at any
-deformation: the edge keeps its rest slope (clamped, symmetry) exactly when the deformed tangent
-across the edge has no component along n0.  The energy term is
+At each Gauss point of such an edge the rotation measure theta is zero exactly when the edge keeps
+its slope, at any deformation.  Clamped: theta = n0 . du/dnu with the rest normal n0 and the rest
+outward conormal nu -- linear in the displacement and exact because the edge does not move, so
+the deformed tangent across it may have no component along n0.  Symmetry: the edge moves and
+turns *within* the plane (normal N), and the surface must meet the plane at right angles, i.e.
+its deformed normal must lie in the plane; theta = m(x) . a_nu(x) with m = unit(a_t x N) of the
+deformed edge tangent a_t (= n0 at rest up to the O(h) tilt of a coarse limit surface, see
+_theta; the linearisation at rest is the clamped one, so linear solves are unchanged).  The clamped
+measure n0 . du/dnu is not enough there: it leaves the tangent across the edge free in the
+span of N and the *rest* edge tangent, so once the edge has turned in the plane the surface can
+tilt out of it -- a partial hinge that makes a symmetry model too soft at large deformation
+(the 1/8 pinched cylinder of Sze, Liu & Lo 2004, benchmarks/nonlinear).  The energy term is
 
     Pi_N(x) = sum_q w_q [ -m_nn(x) theta(x) + gamma D / (2 h) theta(x)^2 ]
 
@@ -43,9 +51,12 @@ class NitscheRotation:
         t_gl, w_gl = np.polynomial.legendre.leggauss(n_points)
         taus, wts = 0.5 * (t_gl + 1.0), 0.5 * w_gl
         st_l, D_l, d_l, n0_l, c_l, w_l, pen_l, t_l = [], [], [], [], [], [], [], []
+        tv_l, plane_l = [], []
         for sup in supports:
             if not isinstance(sup, EdgeSupport) or not sup.directions()[1]:
                 continue
+            dirs, _ = sup.directions()
+            plane = dirs[0] if sup.kind == "symmetry" else np.zeros(3)
             ab = mesh.boundary_edges
             mask = np.asarray(sup.where(xv[ab[:, 0]]), bool) & np.asarray(sup.where(xv[ab[:, 1]]), bool)
             for e in np.flatnonzero(mask):
@@ -72,7 +83,9 @@ class NitscheRotation:
                     nu_con = np.linalg.solve(A, nu_cov)
                     st_l.append(st)
                     D_l.append(Dm)
-                    d_l.append(dN[q] @ nu_con)                                  # theta = n0 . sum_s d_s u_s
+                    d_l.append(dN[q] @ nu_con)                                  # a_nu = sum_s d_s x_s
+                    tv_l.append(dN[q] @ chart)                                  # a_t = sum_s tv_s x_s
+                    plane_l.append(plane)
                     n0_l.append(n0)
                     c_l.append([nu_cov[0] ** 2, nu_cov[1] ** 2, 2.0 * nu_cov[0] * nu_cov[1]])
                     w_l.append(wts[q] * ds)
@@ -87,10 +100,12 @@ class NitscheRotation:
         self._st = np.zeros((K, S), np.int64)
         self._D = np.zeros((K, S, 5))
         self._d = np.zeros((K, S))
-        for k, (s, Dm, d) in enumerate(zip(st_l, D_l, d_l)):
+        self._tv = np.zeros((K, S))
+        for k, (s, Dm, d, tv) in enumerate(zip(st_l, D_l, d_l, tv_l)):
             self._st[k, : len(s)] = s
             self._D[k, : len(s)] = Dm
             self._d[k, : len(s)] = d
+            self._tv[k, : len(s)] = tv
         self._n0 = np.asarray(n0_l)
         self._c = np.asarray(c_l)
         self._w = np.asarray(w_l)
@@ -102,6 +117,74 @@ class NitscheRotation:
         det = a[:, 0] * a[:, 1] - a[:, 2] ** 2
         self._rest_inv = np.stack([a[:, 1] / det, a[:, 0] / det, -a[:, 2] / det], -1)
         self._X = X
+        # symmetry points: theta = (alpha m(x) + beta N) . a_nu(x) with m = sigma unit(a_t x N);
+        # sigma = +-1 and n0 = alpha m(X) + beta N (see _theta)
+        self._plane = np.asarray(plane_l, float)
+        self._sym = np.flatnonzero(np.linalg.norm(self._plane, axis=1) > 0)
+        if len(self._sym):
+            k = self._sym
+            at = np.einsum("ks,ksd->kd", self._tv[k], X[self._st[k]])
+            c = np.cross(at, self._plane[k])
+            c /= np.linalg.norm(c, axis=1)[:, None]
+            self._sigma = np.where(np.einsum("kd,kd->k", c, self._n0[k]) >= 0, 1.0, -1.0)
+            self._alpha = np.abs(np.einsum("kd,kd->k", c, self._n0[k]))
+            self._beta = np.einsum("kd,kd->k", self._plane[k], self._n0[k])
+
+    def _theta(self, x: np.ndarray, order: int = 0):
+        """Rotation measure theta (K,), its gradient (K, S, 3) and (order 2) the second
+        derivatives of the symmetry points' theta, (K_sym, S, S, 3, 3) for ``self._sym``.
+
+        Clamped edges: theta = n0 . (a_nu - A_nu), exact because the edge stays in place.
+        Symmetry edges: the plane (normal N) may not be crossed, so the deformed surface must meet
+        it at right angles, i.e. its normal n = a_t x a_nu / |..| must lie in the plane; then
+        a_nu lies in span(a_t, N) of the *deformed* edge tangent a_t (which turns within the plane
+        at finite deformation).  m . a_nu with m = sigma unit(a_t x N) measures exactly that
+        (m . a_nu = -sigma (n . N) |a_t x a_nu| / |a_t x N|); n0 . a_nu (the clamped measure)
+        would instead leave a_nu free in span(t0, N) of the rest tangent t0 and let the surface
+        tilt out of the plane once the edge turns.  The limit surface of a coarse arc meets the
+        plane only nearly at right angles at rest (n0 . N = O(h)), so the rest normal is split,
+        n0 = alpha m(X) + beta N, and theta = (alpha m(x) + beta N) . a_nu: zero at rest, and
+        its linearisation there is the clamped one, n0 . du/dnu (d m / d a_t . A_nu = 0 because
+        A_nu lies in span(m, N)) -- the linear Nitsche matrix is unchanged."""
+        u = x - self._X
+        xs = x[self._st]
+        grad = self._d[:, :, None] * self._n0[:, None, :]                    # clamped: n0 d_s
+        theta = np.einsum("ksa,ksa->k", grad, u[self._st])
+        k = self._sym
+        if not len(k):
+            return theta, grad, (np.zeros((0,) + grad.shape[1:2] * 2 + (3, 3)) if order == 2 else None)
+        N = self._plane[k]
+        d, tv = self._d[k], self._tv[k]
+        an = np.einsum("ks,ksd->kd", d, xs[k])
+        at = np.einsum("ks,ksd->kd", tv, xs[k])
+        c = self._sigma[:, None] * np.cross(at, N)
+        r = np.linalg.norm(c, axis=1)
+        m = c / r[:, None]
+        vm = np.einsum("kd,kd->k", an, m)
+        al, be = self._alpha, self._beta
+        theta = theta.copy()
+        theta[k] = al * vm + be * np.einsum("kd,kd->k", an, N)
+        P_an = an - vm[:, None] * m                                          # (I - m m) a_nu
+        # c = A a_t with A v = sigma (v x N) = -sigma N x v;  A^T w = sigma N x w
+        g_t = self._sigma[:, None] * np.cross(N, P_an) / r[:, None]         # d (m . a_nu) / d a_t
+        grad = grad.copy()
+        grad[k] = (d[:, :, None] * (al[:, None] * m + be[:, None] * N)[:, None, :]
+                   + tv[:, :, None] * (al[:, None] * g_t)[:, None, :])
+        if order < 2:
+            return theta, grad, None
+        eye = np.eye(3)
+        # A as a matrix: A e_j = sigma (e_j x N)
+        A = self._sigma[:, None, None] * np.cross(eye[None, :, :], N[:, None, :]).transpose(0, 2, 1)
+        P = eye - m[:, :, None] * m[:, None, :]
+        J = np.einsum("kab,kbc->kac", P, A) / r[:, None, None]               # d m / d a_t = d2 theta / d a_nu d a_t
+        hh = -(an[:, :, None] * m[:, None, :] + m[:, :, None] * an[:, None, :]
+               + vm[:, None, None] * (eye - 3.0 * m[:, :, None] * m[:, None, :])) / (r ** 2)[:, None, None]
+        Htt = np.einsum("kab,kbc,kcd->kad", A.transpose(0, 2, 1), hh, A)
+        H = al[:, None, None, None, None] * (
+             d[:, :, None, None, None] * tv[:, None, :, None, None] * J[:, None, None, :, :]
+             + tv[:, :, None, None, None] * d[:, None, :, None, None] * J.transpose(0, 2, 1)[:, None, None, :, :]
+             + tv[:, :, None, None, None] * tv[:, None, :, None, None] * Htt[:, None, None, :, :])
+        return theta, grad, H
 
     def _tangent_derivative(self, s: np.ndarray) -> np.ndarray | None:
         """d/ds of c . d2W/dk ds by central differences (None for a quadratic W)."""
@@ -134,9 +217,7 @@ class NitscheRotation:
         _, dW, ddW = self.shell.material.density(s[:, None, :], self._rest_inv[:, None, :], self._t)
         dW, ddW = dW[:, 0], ddW[:, 0]
         m_nn = (self._c * dW[:, 3:]).sum(1)
-        u = x - self._X
-        dtheta = self._d[:, :, None] * self._n0[:, None, :]                  # (K, S, 3)
-        theta = np.einsum("ksa,ksa->k", dtheta, u[self._st])
+        theta, dtheta, Htheta = self._theta(x, order)                      # (K,), (K, S, 3)
         J = strain_jacobian(y)                                             # (K, 6, 5, 3)
         G = np.einsum("kiKa,ksK->kisa", J, self._D)                        # ds/dx (K, 6, S, 3)
         cm = np.einsum("ki,kij->kj", self._c, ddW[:, 3:, :])               # d m_nn / ds (K, 6)
@@ -152,6 +233,9 @@ class NitscheRotation:
         outer = lambda p, q: p[:, :, None, :, None] * q[:, None, :, None, :]  # noqa: E731  (K,S,S,3,3)
         blocks = w[:, None, None, None, None] * (-(outer(dm, dtheta) + outer(dtheta, dm))
                                                  + pen[:, None, None, None, None] * outer(dtheta, dtheta))
+        k = self._sym
+        if len(k):                                                         # (pen theta - m_nn) d2 theta
+            blocks[k] += (w * (pen * theta - m_nn))[k][:, None, None, None, None] * Htheta
         # -theta d2 m_nn: through d2 s (analytic) and through d3 W (differences of the tangent)
         Hg = strain_hessian_contract(y, cm * (-w * theta)[:, None])        # (K, 5, 3, 5, 3)
         blocks += np.einsum("ksK,kaKLb,ktL->kstab", self._D, Hg.transpose(0, 2, 1, 3, 4), self._D)

@@ -59,3 +59,40 @@ def test_the_rotation_measure_is_exact_at_finite_rotation():
     u = x - X
     theta = np.einsum("ksa,ksa->k", N._d[:, :, None] * N._n0[:, None, :], u[N._st])
     assert np.abs(theta).max() < 1e-12
+
+
+def test_the_symmetry_measure_vanishes_exactly_when_the_surface_meets_the_plane_at_right_angles():
+    """A symmetry plane (normal N) may not be crossed: the mirrored surface is smooth only if the
+    deformed surface meets the plane at right angles, i.e. its normal n lies in the plane (the
+    symmetry conditions of Kirchhoff-Love shells: u . N = 0 and no rotation about the edge; e.g.
+    Kiendl, Bletzinger, Linhard & Wuechner 2009, CMAME 198, 3902, on rotation conditions of KL
+    shells).  At finite deformation the edge turns within the plane, so the condition is on the
+    deformed normal, not on the rest one: for affine maps x -> F x that keep the plane z = L
+    (F e_z = e_z + shear, F's third row (0, 0, 1)) -- which subdivision reproduces exactly -- theta
+    must equal +-(n . N) |a_t x a_nu| / |a_t| at every Gauss point, in particular vanish for a
+    turn about N with any in-plane stretch and not for a turn combined with a shear across the
+    edge (the clamped measure n0 . du/dnu gets both wrong)."""
+    m = cylinder(1.0, 1.0, 6, 4, 0.0, np.pi / 2)
+    sh = Shell(m.vertices, m.faces, LinearElastic(1e5, 0.3), 0.05)
+    N = NitscheRotation(sh, [EdgeSupport("symmetry", lambda x: np.abs(x[:, 2] - 1.0) < 1e-9, normal=(0, 0, 1))],
+                        sh.evaluator)
+    X = sh.rest_positions
+    ez = np.array([0.0, 0.0, 1.0])
+    c, s = np.cos(0.7), np.sin(0.7)
+    turn = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+    maps = {"turn": turn, "turn + in-plane stretch": turn @ np.diag([1.3, 0.8, 1.0]),
+            "turn + shear across": turn @ np.array([[1, 0, 0.0], [0, 1, 0.4], [0, 0, 1]]),
+            "shear across": np.array([[1, 0, 0.3], [0, 1, -0.2], [0, 0, 1.0]])}
+    tilted = 0
+    for name, F in maps.items():
+        x = (X - ez) @ F.T + ez
+        theta = N._theta(x)[0]
+        y = np.einsum("ksK,ksd->kKd", N._D, x[N._st])
+        n = np.cross(y[:, 0], y[:, 1])
+        n /= np.linalg.norm(n, axis=1)[:, None]
+        a_nu = np.einsum("ks,ksd->kd", N._d, x[N._st])
+        a_t = np.einsum("ks,ksd->kd", N._tv, x[N._st])
+        expected = np.abs(n @ ez) * np.linalg.norm(np.cross(a_t, a_nu), axis=1) / np.linalg.norm(a_t, axis=1)
+        assert np.allclose(np.abs(theta), expected, rtol=1e-10, atol=1e-12), name
+        tilted += bool(expected.max() > 1e-3)
+    assert tilted == 2          # the two maps with a shear across the edge tilt the surface
