@@ -33,3 +33,19 @@ def test_symmetry_model_matches_the_full_model_at_large_deformation():
         a, b = _at(eighth, quantity, 1.0), _at(full, quantity, 1.0)
         assert np.isfinite(a) and np.isfinite(b)
         assert abs(a - b) <= bound * abs(b), (quantity, a, b)
+
+
+@pytest.mark.slow
+def test_refined_symmetry_model_matches_the_kirchhoff_love_iga_reference(tmp_path):
+    """At 48 x 48 the 1/8 model at P_max agrees with nligaStruct's Kirchhoff-Love isogeometric
+    solution (SVK, 2860 bicubic elements): -W_A = 83.678, U_B = 35.677 (../shared/BENCHMARKS.md
+    3.6) -- a converged answer of the same shell theory, against which Sze's Abaqus S4R curve
+    (the benchmark's 2 % reference) differs by +0.7 % / +4 %.  About a minute on one core."""
+    text = (NL / "pinched_cylinder_large.toml").read_text()
+    assert "n_theta = 32" in text and "n_z = 32" in text
+    spec = tmp_path / "pinched_cylinder_large_48.toml"
+    spec.write_text(text.replace("n_theta = 32", "n_theta = 48").replace("n_z = 32", "n_z = 48"))
+    records = run_nonlinear_benchmark(spec)
+    w_a, u_b = _at(records, "-probe.A.x", 1.0), _at(records, "probe.B.y", 1.0)
+    assert abs(w_a - 83.678) <= 0.005 * 83.678, w_a
+    assert abs(u_b - 35.677) <= 0.01 * 35.677, u_b
