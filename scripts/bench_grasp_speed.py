@@ -49,9 +49,12 @@ def main() -> None:
         r["wall_s"] = time.perf_counter() - t0
         print(f"run {k}{' (warm-up)' if k == 0 else ''}: wall {r['wall_s']:.1f} s; " +
               ", ".join(f"{n} {v:.1f} s" for n, v in r["timings"].items()) +
-              f"; indentation {r['indentation_mm']:.2f} mm", flush=True)
+              f"; indentation {r['indentation_mm']:.2f} mm" +
+              ("" if r["completed"] else " -- PATH STOPPED before the full force (not a valid timing)"), flush=True)
         if k:
             runs.append(r)
+    if not all(r["completed"] for r in runs):
+        raise SystemExit("some runs stopped before the full force: their times are not comparable")
     med = statistics.median(r["wall_s"] for r in runs)
     print(f"median wall time over {a.runs} runs: {med:.1f} s (target 30 s)")
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)

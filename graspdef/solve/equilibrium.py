@@ -37,11 +37,10 @@ def _same(a: np.ndarray, b: np.ndarray) -> bool:
 
 
 def _add(A: sp.spmatrix, B: sp.spmatrix) -> sp.csr_matrix:
-    """A + B, overwriting A (a matrix the caller owns) when both are CSR on the same index
-    arrays (the shell's shared pattern); else entry by entry on an equal structure, or scipy's sum."""
+    """A + B (a new matrix: the terms may hand out cached matrices); entry by entry when both
+    are CSR on the same index arrays (the shell's shared pattern) or an equal structure."""
     if sp.isspmatrix_csr(A) and sp.isspmatrix_csr(B) and _same(A.indices, B.indices) and _same(A.indptr, B.indptr):
-        A.data += B.data
-        return A
+        return sp.csr_matrix((A.data + B.data, A.indices, A.indptr), shape=A.shape)
     if (sp.isspmatrix_csr(A) and sp.isspmatrix_csr(B) and A.nnz == B.nnz and A.has_sorted_indices
             and B.has_sorted_indices and np.array_equal(A.indptr, B.indptr) and np.array_equal(A.indices, B.indices)):
         return sp.csr_matrix((A.data + B.data, A.indices, A.indptr), shape=A.shape)
