@@ -220,8 +220,8 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     # factorise every converged point (the settings the contact tables were made with; the
     # solver's defaults for smooth paths, reuse_ratio 0.9 and inertia_rtol 1e-4, stop the pinned
     # ball at 12.9 of 20.37 N)
-    contact = {"desired_iterations": 8, "reuse_ratio": 0.5, "inertia_rtol": 0.0} if fingertips else {}
-    opt = PathOptions(steps=steps or spec.steps, max_steps=40 * (steps or spec.steps), min_step=1e-3, **contact)
+    path_opts = {"desired_iterations": 8, "reuse_ratio": 0.5, "inertia_rtol": 0.0} if fingertips else {}
+    opt = PathOptions(steps=steps or spec.steps, max_steps=40 * (steps or spec.steps), min_step=1e-3, **path_opts)
     if analysis == "linear" and p0 > 0:
         raise ProblemError("an enclosed gas needs the nonlinear analysis (p V = const is nonlinear)")
     if analysis == "linear" and not fingertips:
