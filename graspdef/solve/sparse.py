@@ -101,6 +101,13 @@ def kkt_matrix(K: sp.spmatrix, C: sp.spmatrix) -> tuple[sp.csr_matrix, float]:
     return A, scale
 
 
+def same_array(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two arrays are views of the same memory with the same layout (hence equal); the
+    cheap test that two sparse matrices share their index arrays."""
+    return a is b or (a.shape == b.shape and a.dtype == b.dtype and a.strides == b.strides
+                      and a.ctypes.data == b.ctypes.data)
+
+
 class _UpperMap:
     """Where K's upper-triangle entries and C^T's entries go in :func:`kkt_upper`'s matrix, for
     one sparsity pattern of K: later matrices on the same pattern (Newton iterations) only
@@ -121,10 +128,7 @@ class _UpperMap:
         self.c_data = U.data[self.pos_c]
 
     def matches(self, K: sp.csr_matrix) -> bool:
-        same = [a is b or (a.shape == b.shape and a.dtype == b.dtype and a.strides == b.strides
-                           and a.ctypes.data == b.ctypes.data)
-                for a, b in ((K.indptr, self.indptr), (K.indices, self.indices))]
-        return all(same) or (
+        return (same_array(K.indptr, self.indptr) and same_array(K.indices, self.indices)) or (
             K.nnz == self.indices.size and np.array_equal(K.indptr, self.indptr)
             and np.array_equal(K.indices, self.indices))
 
