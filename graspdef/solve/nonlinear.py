@@ -235,7 +235,7 @@ class PathSolver:
             float(np.linalg.norm(cres)) <= 1e-9 * cscale
         return ok, rn / scale
 
-    def newton(self, u0: np.ndarray, lam: float, factored: bool = False, reuse_ratio: float | None = None):
+    def newton(self, u0: np.ndarray, lam: float, factored: bool = False):
         """Equilibrium at fixed load factor from u0; returns (u, state, iterations, instability).
 
         Modified Newton with Anderson acceleration: a factorised tangent is reused (a gradient
@@ -256,7 +256,6 @@ class PathSolver:
         predictor and tangent.  With ``inertia_rtol = 0`` the converged state itself is always
         factorised (one more factorisation per point)."""
         eq, opt = self.eq, self.opt
-        ratio = opt.reuse_ratio if reuse_ratio is None else reuse_ratio
         u = u0.copy()
         first = prev = None
         need_h = not (factored and opt.reuse_factorisation)
@@ -285,7 +284,7 @@ class PathSolver:
             if it >= 8 and rel > 10 * first:
                 raise _Failed(f"Newton diverges at load factor {lam:.6g} (residual {rel:.2e})")
             if not need_h and (near is None and rel <= opt.inertia_rtol
-                               or prev is not None and rel > ratio * prev):
+                               or prev is not None and rel > opt.reuse_ratio * prev):
                 # nearly converged on a tangent from elsewhere (its factorisation at this iterate
                 # gives the stability and the final iterations), or poor contraction: fresh tangent
                 st = eq.evaluate(u, lam, 2)
@@ -442,7 +441,6 @@ class PathSolver:
         lam = 0.0
         factored = True                 # the factorisation is at the current converged point
         back = None                     # the previous converged point (u, lam)
-        retry = False                   # the last attempt failed
         while len(sol.path) <= opt.max_steps:
             nxt = next(s for s in stops if (s - lam) * np.sign(lam_end) > 1e-12 * abs(lam_end))
             step = dlam if abs(dlam) < abs(nxt - lam) * (1 + 1e-9) else nxt - lam
@@ -459,20 +457,14 @@ class PathSolver:
             except SolverError:
                 u0, factored = u.copy(), False
             try:
-                # after a failed attempt the retry refreshes the tangent as soon as the contraction
-                # is worse than 1/2 (a stale tangent kept through slow contraction is what fails
-                # first on hard steps, e.g. a contact patch growing)
-                u_new, st, its, inst = self.newton(u0, lam_new, factored=factored,
-                                                   reuse_ratio=min(opt.reuse_ratio, 0.5) if retry else None)
+                u_new, st, its, inst = self.newton(u0, lam_new, factored=factored)
             except (_Failed, SolverError) as exc:
                 factored = False
-                retry = True
                 if abs(step) / 2 < dmin:
                     raise _Failed(f"load step cut below {dmin:.3g} at load factor {lam:.6g}: {exc}") from None
                 log.info("step to %.6g failed (%s); halving", lam_new, exc)
                 dlam = step / 2
                 continue
-            retry = False
             is_target = abs(lam_new - nxt) <= 1e-12 * abs(lam_end)
             pt = self._record(u_new, lam_new, st, its, inst, "target" if is_target and nxt != lam_end else "step")
             sol.path.append(pt)
