@@ -33,10 +33,10 @@ from .sparse import KKTSystem, same_array
 def _add(A: sp.spmatrix, B: sp.spmatrix) -> sp.csr_matrix:
     """A + B (a new matrix: the terms may hand out cached matrices); entry by entry when both
     are CSR on the same index arrays (the shell's shared pattern) or an equal structure."""
-    if sp.isspmatrix_csr(A) and sp.isspmatrix_csr(B) and same_array(A.indices, B.indices) and same_array(A.indptr, B.indptr):
-        return sp.csr_matrix((A.data + B.data, A.indices, A.indptr), shape=A.shape)
-    if (sp.isspmatrix_csr(A) and sp.isspmatrix_csr(B) and A.nnz == B.nnz and A.has_sorted_indices
-            and B.has_sorted_indices and np.array_equal(A.indptr, B.indptr) and np.array_equal(A.indices, B.indices)):
+    if sp.isspmatrix_csr(A) and sp.isspmatrix_csr(B) and (
+            (same_array(A.indices, B.indices) and same_array(A.indptr, B.indptr))
+            or (A.nnz == B.nnz and A.has_sorted_indices and B.has_sorted_indices
+                and np.array_equal(A.indptr, B.indptr) and np.array_equal(A.indices, B.indices))):
         return sp.csr_matrix((A.data + B.data, A.indices, A.indptr), shape=A.shape)
     return (A + B).tocsr()
 

@@ -117,11 +117,9 @@ class _UpperMap:
         self.indptr, self.indices = K.indptr, K.indices
         U = kkt_upper(sp.csr_matrix((np.arange(1, K.nnz + 1, dtype=float), K.indices, K.indptr), shape=K.shape),
                       C, 1.0)
-        n = K.shape[0]
-        self.n = n
         self.shape = U.shape
         self.U_indptr, self.U_indices = U.indptr, U.indices
-        is_k = U.indices < n
+        is_k = U.indices < K.shape[0]
         self.pos_k = np.flatnonzero(is_k)
         self.src_k = U.data[is_k].astype(np.int64) - 1          # K.data index of each upper entry
         self.pos_c = np.flatnonzero(~is_k & (U.data != 0))
@@ -186,8 +184,7 @@ class KKTSystem:
         self.C = C.tocsr()
         self.m = self.C.shape[0]
         self._solver = None
-        self._pattern = None
-        self._map: _UpperMap | None = None
+        self._map: _UpperMap | None = None                 # K's pattern, analysed by PARDISO
         self._lu = None
         self.n_negative: int | None = None
         self.perturbed = 0
@@ -205,7 +202,7 @@ class KKTSystem:
         if self._solver is not None:
             self._solver.free_memory(everything=True)
             self._solver = None
-            self._pattern = None
+            self._map = None                                # a new solver needs a new analysis
 
     def factor(self, K: sp.spmatrix, analyse: bool = False) -> None:
         """Factor the KKT matrix of ``K``; ``analyse`` forces a fresh ordering/matching."""
@@ -219,10 +216,9 @@ class KKTSystem:
             K = self.K
             if not K.has_sorted_indices:
                 K = K.sorted_indices()
-            if self._map is None or not self._map.matches(K):
-                self._map = _UpperMap(K, self.C)
-            U = self._map.upper(K, self.scale)
-            pattern = (U.shape, U.nnz, hash(U.indices[:: max(1, U.nnz // 4096)].tobytes()))
+            new_pattern = self._map is None or not self._map.matches(K)
+            upper_map = _UpperMap(K, self.C) if new_pattern else self._map
+            U = upper_map.upper(K, self.scale)
             if self._solver is None:
                 self._solver = _new_pardiso(-2)
                 for k, v in _PARDISO_IPARM.items():
@@ -230,10 +226,10 @@ class KKTSystem:
             s = self._solver
             s._check_A(U)
             z = np.zeros((U.shape[0], 1))
-            if analyse or pattern != self._pattern:
+            if analyse or new_pattern:
                 s.set_phase(11)                             # analysis (matching, ordering)
                 s._call_pardiso(U, z)
-                self._pattern = pattern
+                self._map = upper_map                       # kept once PARDISO has analysed it
             s.set_phase(22)                                 # numerical factorisation
             s._call_pardiso(U, z)
             self._U = U
