@@ -44,4 +44,7 @@ def main():
 
 
 if __name__ == "__main__":
+    from graspdef import runtime
+
+    runtime.configure()        # OpenMP wait policy before any solve (graspdef.runtime)
     main()

@@ -94,4 +94,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    from graspdef import runtime
+
+    runtime.configure()        # OpenMP wait policy before any solve (graspdef.runtime)
     main()

@@ -59,6 +59,9 @@ def main(fast: bool = False, out: str = "out/convergence") -> dict:
 
 
 if __name__ == "__main__":
+    from graspdef import runtime
+
+    runtime.configure()        # OpenMP wait policy before any solve (graspdef.runtime)
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default="out/convergence")
     ap.add_argument("--fast", action="store_true", help="small meshes only")

@@ -375,4 +375,7 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
+    from graspdef import runtime
+
+    runtime.configure()        # OpenMP wait policy before any solve (graspdef.runtime)
     sys.exit(main())

@@ -13,5 +13,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent / "gallery"))
 from thesis_fig10_13_hemisphere import main  # noqa: E402
 
 if __name__ == "__main__":
+    from graspdef import runtime
+
+    runtime.configure()        # OpenMP wait policy before any solve (graspdef.runtime)
     argv = sys.argv[1:]
     main(argv if any(x.startswith("--out") for x in argv) else ["--out", "out/thesis"] + argv)

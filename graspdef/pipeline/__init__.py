@@ -1,11 +1,10 @@
 """The grasp chain: MuJoCo scene -> settled contacts -> point loads on the shell -> linear or
 nonlinear shell solve -> run folder (graspdef.pipeline.grasp).
 
-Importing this package is cheap (the command line builds its parser from
-:mod:`graspdef.pipeline.cli_args`); the chain itself loads on first use (PEP 562)."""
+Importing this package is cheap; the chain itself loads on first use (PEP 562)."""
 from __future__ import annotations
 
-__all__ = ["GraspRun", "ShellSpec", "grasp_cli", "load_shell_spec", "run_grasp"]
+__all__ = ["GraspRun", "ShellSpec", "load_shell_spec", "run_grasp"]
 
 
 def __getattr__(name: str):

@@ -20,7 +20,6 @@ The chain (issue 5):
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import logging
@@ -355,36 +354,3 @@ def _write(out: Path, rec: dict, g, sol, x_lim, u_def, config: dict | None = Non
                 for i, p in enumerate(sol.path):
                     w.writerow([i, p.load_factor, p.iterations] + [float(v) for n in names for v in p.probes[n]])
 
-
-def grasp_cli(argv: list[str] | None = None) -> int:
-    """``graspdef grasp SCENE --force F [--contact point|geometric] [--analysis ...] --out DIR``."""
-    from .cli_args import add_grasp_arguments
-
-    ap = argparse.ArgumentParser(prog="graspdef grasp", description="MuJoCo grasp -> shell deformation run folder")
-    add_grasp_arguments(ap)
-    return run_from_args(ap.parse_args(argv))
-
-
-def run_from_args(a) -> int:
-    """Run the chain for parsed arguments (see :mod:`graspdef.pipeline.cli_args`); prints two
-    lines (the result, the run folder); a GraspdefError prints one error line, returns 2."""
-    import sys
-
-    gas = {"auto": None, "on": True, "off": False}[a.gas]
-    E = None if getattr(a, "E_MPa", None) is None else a.E_MPa * 1e6
-    try:
-        run = run_grasp(a.scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E)
-    except (GraspdefError, OSError) as exc:
-        print(f"graspdef: error: {exc}", file=sys.stderr)
-        return 2
-    r = run.result
-    fb = r["feedback"]
-    ind = fb.get("indentation_per_finger_m", fb.get("indentation_m", 0.0))
-    stop = "" if r["convergence"]["completed"] else f" (path stopped at load factor {r['convergence'].get('load_factor', 0):.3g})"
-    model = "point loads" if r["contact"] == "point" else "geometric contact"
-    area = f", contact area {r['contact_area_m2'] * 1e6:.1f} mm^2" if r["contact"] == "geometric" else ""
-    print(f"{r['object']}: {r['analysis']} shell, {model}, {r['force_N']:g} N per finger: indentation "
-          f"{ind * 1e3:.2f} mm per finger, max displacement {r['max_displacement_m'] * 1e3:.2f} mm{area}{stop}; "
-          f"{r['timings_s']['total']:.1f} s")
-    print(f"run folder: {run.out}")
-    return 0

@@ -1,6 +1,6 @@
 """HTML reports of run folders (issue 6): headless surface pictures (:mod:`.render`), plots
-(:mod:`.plots`), the self-contained page (:mod:`.html`), the report itself (:mod:`.build`) and
-``graspdef report`` (:mod:`.cli`).  matplotlib (Agg, object-oriented API) only; open3d only
+(:mod:`.plots`), the self-contained page (:mod:`.html`) and the report itself (:mod:`.build`;
+``graspdef report`` is :mod:`graspdef.cli.report`).  matplotlib (Agg, object-oriented API) only; open3d only
 through :mod:`graspdef.registration`, and only when a scan is scored."""
 from __future__ import annotations
 

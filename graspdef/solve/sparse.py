@@ -49,42 +49,19 @@ class KKTResult:
 
 def pardiso_available() -> bool:
     try:
-        _locate_mkl_rt()
         import pypardiso  # noqa: F401  (availability probe)
     except Exception:       # ImportError, or mkl_rt missing
         return False
     return True
 
 
-def _locate_mkl_rt() -> None:
-    """Name MKL's runtime library in PYPARDISO_MKL_RT (if unset) when it sits directly in the
-    environment's lib folder (pip's mkl wheel), so that importing pypardiso skips its recursive
-    search of sys.prefix."""
-    import glob
-    import os
-    import sys
-
-    if "PYPARDISO_MKL_RT" in os.environ:
-        return
-    found = sorted(glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*")), key=len)
-    if found:
-        os.environ["PYPARDISO_MKL_RT"] = found[0]
-
-
 def _new_pardiso(mtype: int):
     """A PyPardisoSolver.  pypardiso looks for MKL's runtime library on every solver it creates
     (a recursive search of sys.prefix, ~1 s, and 2-4 s on a loaded machine) unless the environment
-    variable PYPARDISO_MKL_RT names it: set it (if unset) to the library the module loaded at
-    import."""
-    import os
-
-    _locate_mkl_rt()
+    variable PYPARDISO_MKL_RT names it, which :func:`graspdef.runtime.configure` does (the
+    command line calls it at start)."""
     import pypardiso
 
-    if "PYPARDISO_MKL_RT" not in os.environ:
-        name = getattr(getattr(getattr(pypardiso, "ps", None), "libmkl", None), "_name", None)
-        if name:
-            os.environ["PYPARDISO_MKL_RT"] = str(name)
     return pypardiso.PyPardisoSolver(mtype=mtype)
 
 

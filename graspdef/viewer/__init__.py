@@ -19,12 +19,5 @@ def view(run_dirs, host: str = "127.0.0.1", port: int = 8080, block: bool = True
     return _view(run_dirs, host, port, block, **kwargs)
 
 
-def viewer_cli(args) -> int:
-    """``graspdef view``; see :func:`graspdef.viewer.cli.viewer_cli`."""
-    from .cli import viewer_cli as _cli
-
-    return _cli(args)
-
-
-__all__ = ["view", "viewer_cli", "read_run", "RunData", "RunFolderError", "read_path_u", "write_path_u",
+__all__ = ["view", "read_run", "RunData", "RunFolderError", "read_path_u", "write_path_u",
            "write_solution_path"]

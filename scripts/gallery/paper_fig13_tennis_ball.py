@@ -69,4 +69,7 @@ def main(argv: list[str] | None = None) -> dict:
 
 
 if __name__ == "__main__":
+    from graspdef import runtime
+
+    runtime.configure()        # OpenMP wait policy before any solve (graspdef.runtime)
     main()

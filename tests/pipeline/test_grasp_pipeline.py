@@ -7,7 +7,12 @@ import pytest
 import mujoco  # noqa: F401  (the sim extra is part of make test)
 
 from graspdef.errors import GraspdefError
-from graspdef.pipeline import grasp_cli, run_grasp
+from graspdef.cli import main as graspdef_main
+from graspdef.pipeline import run_grasp
+
+
+def grasp_cli(argv):
+    return graspdef_main(["grasp", *argv])
 
 
 def test_tennis_ball_linear_chain(tmp_path):

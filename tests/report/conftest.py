@@ -124,9 +124,9 @@ def scored_report(ball_run, ball_scan, tmp_path_factory) -> Path:
     ``--scan`` (the score written to RUN/score)."""
     import shutil
 
-    from graspdef.report.cli import main as report_main
+    from graspdef.cli import main
 
     d = tmp_path_factory.mktemp("scored") / "ball"
     shutil.copytree(ball_run, d)
-    assert report_main([str(d), "--scan", str(ball_scan)]) == 0
+    assert main(["report", str(d), "--scan", str(ball_scan)]) == 0
     return d

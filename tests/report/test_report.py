@@ -11,7 +11,11 @@ import pytest
 
 from graspdef.errors import GraspdefError
 from graspdef.report.build import ReportError, build_report
-from graspdef.report.cli import main as report_main
+from graspdef.cli import main as graspdef_main
+
+
+def report_main(argv):
+    return graspdef_main(["report", *argv])
 
 
 def _self_contained(text: str) -> None:

@@ -127,7 +127,7 @@ def test_example_specs_are_valid():
 
 
 def test_help_example_spec_parses():
-    from graspdef.sweep.cli import EPILOG
+    from graspdef.cli.sweep import EPILOG
 
     text = "\n".join(line[2:] for line in EPILOG.split("a spec (docs/sweep.md):\n")[1].splitlines())
     assert len(parse_spec(text, "help.toml").cases) == 2 * 2 * 2

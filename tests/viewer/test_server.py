@@ -11,10 +11,13 @@ import pytest
 
 import viser  # noqa: F401  (the viewer extra is part of make test)
 
-from graspdef.viewer.cli import main as view_main  # noqa: E402
+from graspdef.cli import main as graspdef_main  # noqa: E402
 from graspdef.viewer.runs import RunFolderError  # noqa: E402
 from graspdef.viewer.server import Viewer, ViewerError  # noqa: E402
 
+
+def view_main(argv):
+    return graspdef_main(["view", *argv])
 
 
 def port_is_free(port: int, host: str = "127.0.0.1") -> bool:

@@ -2,10 +2,14 @@
 from __future__ import annotations
 
 import argparse
-import sys
+
+from ._common import progress
+
+HELP = "serve run folders in the browser (viser on 127.0.0.1:8080)"
+DESCRIPTION = "Serve run folders as a viser page (127.0.0.1 unless --host); Ctrl-C stops it."
 
 
-def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
+def add_arguments(p: argparse.ArgumentParser) -> None:
     """The ``view`` sub-command's arguments (call on the sub-parser)."""
     p.add_argument("run_dirs", nargs="+", metavar="RUN_DIR", help="run folders (graspdef solve --out), side by side")
     p.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only)")
@@ -14,37 +18,19 @@ def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
                    help="a 'graspdef score' folder for the scan overlay, one per run in order (default: "
                         "score.json in the run folder or a sub-folder)")
     p.add_argument("--no-live", dest="live", action="store_false", help="no live re-solve sliders")
-    return p
 
 
-def viewer_cli(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace) -> int:
     """Run the viewer until Ctrl-C.  Errors (missing or incomplete run folder, port in use) are
     raised as GraspdefError subclasses, which ``graspdef``'s main turns into one line and exit 2."""
-    from .server import Viewer
+    from ..viewer.server import Viewer
 
     v = Viewer(args.run_dirs, args.host, args.port, score_dirs=getattr(args, "score", None),
                live=getattr(args, "live", True))
     try:
-        if not getattr(args, "quiet", False):
-            print(f"[graspdef] viewer at {v.url} ({len(v.runs)} run(s)); Ctrl-C stops it", file=sys.stderr, flush=True)
+        progress(args, f"viewer at {v.url} ({len(v.runs)} run(s)); Ctrl-C stops it")
         v.wait()
     finally:
         v.stop()
     return 0
 
-
-def main(argv: list[str] | None = None) -> int:
-    """Stand-alone entry (``python -m graspdef.viewer.cli RUN_DIR``) until cli.py wires ``view`` in."""
-    from ..errors import GraspdefError
-
-    ap = add_arguments(argparse.ArgumentParser(prog="graspdef view", description="Serve run folders in the browser."))
-    args = ap.parse_args(argv)
-    try:
-        return viewer_cli(args)
-    except GraspdefError as exc:
-        print(f"graspdef: error: {exc}", file=sys.stderr)
-        return 2
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -4,9 +4,14 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Callable
 
 from ..errors import ProblemError
+from ._common import progress
+
+HELP = "run a grid of grasps (objects x forces x materials x contacts x meshes)"
+DESCRIPTION = ("Run every case of a sweep spec (TOML) in parallel -- an embedded local cluster, or a dask.distributed "
+               "cluster with --scheduler -- into a resumable sweep folder: one run folder per case, results.csv and "
+               "summary.md.")
 
 
 EPILOG = """examples:
@@ -44,11 +49,11 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="seconds to wait for the scheduler and its first worker (default 5)")
 
 
-def run_from_args(args: argparse.Namespace, progress: Callable[[str], None] | None = None) -> int:
+def run(args: argparse.Namespace) -> int:
     """Run the sweep for parsed arguments; prints one line (the summary); 0 when every case is
     done, 1 when some failed (their errors are in summary.md and results.csv)."""
-    from .run import run_sweep
-    from .spec import load_spec
+    from ..sweep.run import run_sweep
+    from ..sweep.spec import load_spec
 
     src = Path(args.spec)
     if src.is_dir():
@@ -61,7 +66,8 @@ def run_from_args(args: argparse.Namespace, progress: Callable[[str], None] | No
         spec_file, out = src, Path(args.out)
     spec = load_spec(spec_file)
     res = run_sweep(spec, out, scheduler=args.scheduler, workers=args.workers, retry_failed=args.retry_failed,
-                    parquet=args.parquet, connect_timeout=args.connect_timeout, progress=progress)
+                    parquet=args.parquet, connect_timeout=args.connect_timeout,
+                    progress=lambda m: progress(args, m))
     print(f"{spec.name}: {res.n_done} done, {res.n_failed} failed of {res.n_cases} cases "
           f"({res.n_run} run now, {res.n_skipped} reused); {res.out / 'results.csv'}, {res.out / 'summary.md'}")
     return 0 if res.n_failed == 0 and res.n_done == res.n_cases else 1

@@ -2,10 +2,16 @@
 from __future__ import annotations
 
 import argparse
-import sys
+
+from ._common import progress, warn
+
+HELP = "write a self-contained HTML report of run folders (report.html)"
+DESCRIPTION = ("One HTML page (pictures inlined, no external URL): the deformed surface coloured by displacement and "
+               "by scan error, load-deflection and convergence plots, and a table in the layout of Tian & Jia's "
+               "Table I for several grasp runs.")
 
 
-def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
+def add_arguments(p: argparse.ArgumentParser) -> None:
     """The ``report`` sub-command's arguments (call on the sub-parser)."""
     p.add_argument("run_dirs", nargs="*", metavar="RUN_DIR",
                    help="run folders (graspdef solve/grasp --out); several grasp runs make the Table I comparison")
@@ -21,17 +27,15 @@ def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
                    help="CSV with columns run[,force_N][,measured_mm]: more run folders for the Table I "
                         "comparison (paths relative to the CSV)")
     p.add_argument("--title", help="page title")
-    return p
 
 
 def run(args: argparse.Namespace) -> int:
     """Write the report; 0, or 1 if a score is flagged (the page is written and says so).  Errors
     are GraspdefError subclasses (one line, exit status 2 in graspdef's main)."""
-    from .build import build_report
+    from ..report.build import build_report
 
     def say(msg: str) -> None:
-        if not getattr(args, "quiet", False):
-            print(f"[graspdef] {msg}", file=sys.stderr, flush=True)
+        progress(args, msg)
 
     flagged: list = []
     out = build_report(args.run_dirs, args.out, scan=args.scan, table=args.table, title=args.title,
@@ -39,23 +43,6 @@ def run(args: argparse.Namespace) -> int:
                        flagged=flagged)
     say(f"wrote {out}")
     for run_dir, flags in flagged:       # like 'graspdef score': a flagged score is exit status 1
-        print(f"graspdef: warning: the score of {run_dir} is flagged ({', '.join(flags) or 'ok = false'}); "
-              "the report shows it", file=sys.stderr)
+        warn(f"the score of {run_dir} is flagged ({', '.join(flags) or 'ok = false'}); the report shows it")
     return 1 if flagged else 0
 
-
-def main(argv: list[str] | None = None) -> int:
-    """Stand-alone entry (``python -m graspdef.report.cli RUN_DIR``)."""
-    from ..errors import GraspdefError
-
-    ap = add_arguments(argparse.ArgumentParser(prog="graspdef report", description="Write an HTML report of run folders."))
-    args = ap.parse_args(argv)
-    try:
-        return run(args)
-    except (GraspdefError, OSError) as exc:
-        print(f"graspdef: error: {exc}", file=sys.stderr)
-        return 2
-
-
-if __name__ == "__main__":
-    sys.exit(main())

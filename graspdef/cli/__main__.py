@@ -1,0 +1,6 @@
+"""``python -m graspdef.cli ...`` = ``graspdef ...``."""
+import sys
+
+from . import main
+
+sys.exit(main())

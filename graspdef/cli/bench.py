@@ -1,0 +1,56 @@
+"""``graspdef bench linear|nonlinear|axisym [--json FILE] [--out DIR]``: run a benchmark set."""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from ._common import progress
+
+HELP = "run a benchmark set and print/write the comparison table"
+DESCRIPTION = HELP
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("set", choices=["linear", "nonlinear", "axisym"], help="which benchmark set")
+    p.add_argument("--json", help="write the records to this JSON file")
+    p.add_argument("--dir", help="folder with the benchmark problem files (default: the repository's "
+                                 "benchmarks/, benchmarks/nonlinear/)")
+    p.add_argument("--only", default="*", help="glob of benchmark names to run")
+    p.add_argument("--out", help="also write a run folder: bench.json, table.md, provenance.json")
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..bench import format_table, run_linear_benchmarks, run_nonlinear_benchmarks
+
+    def say(m: str) -> None:
+        progress(args, m)
+
+    root = Path(args.dir) if args.dir else Path(__file__).resolve().parents[2] / "benchmarks"
+    if args.set == "linear":
+        records = run_linear_benchmarks(root, pattern=args.only, progress=say)
+    elif args.set == "nonlinear":
+        records = run_nonlinear_benchmarks(root / "nonlinear" if not args.dir else root, pattern=args.only,
+                                           progress=say)
+    else:
+        from ..axisym.bench import run_axisym_bench
+
+        records = run_axisym_bench(progress=say)
+    print(format_table(records))
+    if args.json:
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.json).write_text(json.dumps(records, indent=2, default=float) + "\n")
+        say(f"wrote {args.json}")
+    if args.out:
+        from ..geometry.io import atomic_folder
+        from ..geometry.provenance import write_provenance
+
+        with atomic_folder(args.out) as tmp:
+            (tmp / "bench.json").write_text(json.dumps(records, indent=2, default=float) + "\n")
+            (tmp / "table.md").write_text(format_table(records) + "\n")
+            write_provenance(tmp, {"set": args.set, "dir": str(root), "only": args.only})
+        say(f"wrote {args.out}/ (bench.json, table.md, provenance.json)")
+    failed = [r["name"] for r in records if not r.get("passed", True)]
+    if failed:
+        say(f"outside tolerance: {', '.join(failed)}")
+    return 0

@@ -1,0 +1,45 @@
+"""``graspdef grasp SCENE --force F [--contact point|geometric] [--analysis ...] --out DIR``."""
+from __future__ import annotations
+
+import argparse
+
+from ._common import progress
+
+HELP = "MuJoCo grasp -> contacts -> shell deformation (a run folder)"
+DESCRIPTION = ("Close the scene's gripper to the force per finger, settle, map the contacts onto the object's shell "
+               "and solve; writes a run folder.")
+
+
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    ap.add_argument("scene", help="scene.xml, its folder, or a name under scenes/ (e.g. tennis_ball)")
+    ap.add_argument("--force", type=float, required=True, help="squeezing force per finger [N]")
+    ap.add_argument("--contact", choices=["point", "geometric"], default="point",
+                    help="point loads (the paper's model) or geometric: the fingertips as rigid, force-controlled, "
+                         "penetration-free obstacles (contact area grows with the load)")
+    ap.add_argument("--analysis", choices=["linear", "nonlinear"], default="nonlinear")
+    ap.add_argument("--gas", choices=["auto", "on", "off"], default="auto",
+                    help="enclosed air: auto = shell.toml's (nonlinear only), on (80 kPa if none given), off")
+    ap.add_argument("--E-MPa", dest="E_MPa", type=float, help="override shell.toml's Young's modulus [MPa]")
+    ap.add_argument("--out", required=True, help="run folder to write (replaced if it exists)")
+
+
+def run(a: argparse.Namespace) -> int:
+    """Run the chain for parsed arguments; prints two lines (the result, the run folder)."""
+    from ..pipeline.grasp import run_grasp
+
+    gas = {"auto": None, "on": True, "off": False}[a.gas]
+    E = None if getattr(a, "E_MPa", None) is None else a.E_MPa * 1e6
+    run = run_grasp(a.scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E)
+    r = run.result
+    fb = r["feedback"]
+    ind = fb.get("indentation_per_finger_m", fb.get("indentation_m", 0.0))
+    stop = "" if r["convergence"]["completed"] else \
+        f" (path stopped at load factor {r['convergence'].get('load_factor', 0):.3g})"
+    model = "point loads" if r["contact"] == "point" else "geometric contact"
+    area = f", contact area {r['contact_area_m2'] * 1e6:.1f} mm^2" if r["contact"] == "geometric" else ""
+    print(f"{r['object']}: {r['analysis']} shell, {model}, {r['force_N']:g} N per finger: indentation "
+          f"{ind * 1e3:.2f} mm per finger, max displacement {r['max_displacement_m'] * 1e3:.2f} mm{area}{stop}; "
+          f"{r['timings_s']['total']:.1f} s")
+    print(f"run folder: {run.out}")
+    progress(a, f"look at it: graspdef report {run.out}, or graspdef view {run.out}")
+    return 0

@@ -1,0 +1,36 @@
+"""``graspdef score PREDICTION SCAN --out DIR``: register a scan to a predicted surface, score it."""
+from __future__ import annotations
+
+import argparse
+
+from ._common import progress
+
+HELP = "register a scan to a predicted surface and score it (score.json)"
+DESCRIPTION = ("Rigid registration (open3d ICP) of a scan to a predicted surface; writes score.json and per-vertex "
+               "errors, with the undeformed shape as the baseline.")
+
+
+def add_arguments(c: argparse.ArgumentParser) -> None:
+    c.add_argument("prediction", help="predicted surface (a run folder's deformed.ply)")
+    c.add_argument("scan", help="scan file or a scans/manifest.toml id (e.g. ycb_056_tennis_ball)")
+    c.add_argument("--out", required=True, help="output folder")
+    c.add_argument("--undeformed", help="undeformed surface (default: undeformed.ply beside the prediction)")
+    c.add_argument("--prediction-units", help="length unit of the prediction file (default: its 'comment units')")
+    c.add_argument("--scan-units", help="length unit of the scan file")
+    c.add_argument("--init", default="pca", choices=["pca", "centroid", "identity"], help="coarse alignment")
+    c.add_argument("--region", help="undeformed region to align on, e.g. 'z < -10' (prediction units)")
+    c.add_argument("--surface-offset-mm", type=float, default=0.0, help="mid-surface to outer-surface offset [mm]")
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..registration import score_cli
+
+    rec = score_cli(args.prediction, args.scan, args.out, undeformed_path=args.undeformed,
+                    prediction_units=args.prediction_units, scan_units=args.scan_units,
+                    init=args.init, region=args.region, surface_offset_mm=args.surface_offset_mm)
+    print(rec["summary"])
+    if not rec["ok"]:
+        progress(args, f"the score is flagged ({', '.join(rec.get('flags', [])) or 'see score.json'}); "
+                       f"wrote {args.out}/score.json")
+        return 1
+    return 0
