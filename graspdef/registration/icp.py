@@ -16,7 +16,8 @@ Procedure (lengths in metres):
    measure everywhere;
 5. convergence check: 5 more ICP iterations from the result must move the scan points along
    the surface normal by less than ``converge_tol`` (RMS); otherwise the result is flagged
-   ``not_converged``.
+   ``not_converged``.  Every ICP runs on one thread (:func:`_icp`), so a registration is a
+   function of its input: the same scan and surface give the same transform and flags.
 """
 
 from __future__ import annotations
@@ -172,12 +173,22 @@ def sample_surface(mesh: TriMesh, n: int, seed: int = 0, face_mask: np.ndarray |
 
 def _icp(source, target, init: np.ndarray, max_distance: float, tukey_k: float,
          iterations: int):
+    """open3d's point-to-plane ICP with Tukey's loss, on one thread: with several, its parallel
+    sums differ between runs at round-off (1e-13), which the nearly free rotations of a
+    symmetric object amplify into different registrations (millimetres apart on a ball) and
+    different convergence flags.  One thread makes a registration a function of its input; the
+    thread count of the process is restored afterwards."""
     o3d = _o3d()
     reg = o3d.pipelines.registration
     est = reg.TransformationEstimationPointToPlane(reg.TukeyLoss(k=tukey_k))
     crit = reg.ICPConvergenceCriteria(relative_fitness=1e-10, relative_rmse=1e-10,
                                       max_iteration=int(iterations))
-    return reg.registration_icp(source, target, max_distance, init, est, crit)
+    threads = o3d.utility.get_max_threads()
+    o3d.utility.set_max_threads(1)
+    try:
+        return reg.registration_icp(source, target, max_distance, init, est, crit)
+    finally:
+        o3d.utility.set_max_threads(threads)
 
 
 def _pca_frame(points: np.ndarray):
