@@ -14,15 +14,23 @@ DEB_PACKAGES := libgomp1 libusb-1.0-0 chromium chromium-driver
 system-packages:
 	@if [ "$$(id -u)" = "0" ] && command -v apt-get >/dev/null 2>&1; then \
 	  missing=""; for p in $(DEB_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
-	  if [ -n "$$missing" ]; then apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; fi; \
+	  if [ -n "$$missing" ]; then echo "installing Debian packages:$$missing"; \
+	    ( apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing ) > /tmp/graspdef-apt.log 2>&1 \
+	    || { tail -n 40 /tmp/graspdef-apt.log; echo "apt-get failed: see /tmp/graspdef-apt.log"; exit 1; }; fi; \
 	else echo "not root: skipping Debian packages ($(DEB_PACKAGES))"; fi
 
+SETUP_LOG := $(VENV)/setup.log
+
+# The set-up's output goes to .venv/setup.log; it is shown only if a step fails.
 $(STAMP): pyproject.toml
-	$(MAKE) system-packages
-	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e ".[dev,bench,register,viewer,sim,sweep]"
-	touch $(STAMP)
+	@$(MAKE) --no-print-directory system-packages
+	@echo "setting up $(VENV) (log: $(SETUP_LOG)) ..."
+	@$(PYTHON) -m venv $(VENV)
+	@( $(PY) -m pip install --upgrade pip && \
+	   $(PY) -m pip install -e ".[dev,bench,register,viewer,sim,sweep]" ) > $(SETUP_LOG) 2>&1 \
+	  || { tail -n 40 $(SETUP_LOG); echo "set-up failed: the whole log is $(SETUP_LOG)"; exit 1; }
+	@touch $(STAMP)
+	@echo "set-up done"
 
 setup: $(STAMP)
 
