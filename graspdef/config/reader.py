@@ -161,9 +161,9 @@ class Table(Mapping):
             raise ConfigError(f"{self.source}: [{self._child_name(key)}] must be a table, got {v!r}")
         return Table(v, self.source, self._child_name(key))
 
-    def tables(self, key: str, required: bool = False) -> list["Table"]:
-        """The array of tables ``[[key]]`` as Tables named ``"key 1"``, ``"key 2"``, ...
-        (an empty list if absent and not ``required``; if ``required``, at least one)."""
+    def tables(self, key: str, required: bool = False, start: int = 1) -> list["Table"]:
+        """The array of tables ``[[key]]`` as Tables named ``"key 1"``, ``"key 2"``, ... (numbered
+        from ``start``; an empty list if absent and not ``required``; if ``required``, at least one)."""
         v = self.data.get(key)
         if v is None:
             if required:
@@ -173,7 +173,7 @@ class Table(Mapping):
             raise ConfigError(f"{self.source}: [[{key}]] must be an array of tables, got {v!r}")
         if required and not v:
             raise ConfigError(f"{self.source}: [[{key}]] must list at least one entry")
-        return [Table(t, self.source, f"{key} {i + 1}") for i, t in enumerate(v)]
+        return [Table(t, self.source, f"{key} {i}") for i, t in enumerate(v, start)]
 
     def children(self) -> dict[str, "Table"]:
         """A table of tables (``[materials.a]``, ``[materials.b]``) as {name: Table}."""
@@ -291,13 +291,16 @@ class Table(Mapping):
         return out
 
     def quantity(self, key: str, dimension: str, default=REQUIRED, *, implied=None,
-                 positive: bool = False) -> float:
+                 positive: bool = False, unitless: str | None = None) -> float:
         """A quantity of ``dimension`` in SI (``"2.5 mm"`` -> 0.0025; see :mod:`graspdef.units`);
-        ``implied``: the unit (name or SI factor) of a plain number, which is refused without it;
-        ``positive``: > 0."""
+        ``implied``: the unit of a plain number (name, SI factor or conversion), which is refused
+        without it; ``positive``: > 0; ``unitless``: the reason why this file takes plain numbers
+        only (e.g. "the file's units are 'consistent'"), refusing text with a unit."""
         v = self._raw(key, default)
         if key not in self.data:
             return v
+        if unitless is not None and isinstance(v, str):
+            raise self.error(f"has a unit ({v!r}) but {unitless}: give a plain number", key)
         x = _units.quantity(v, dimension, implied, self.where(key))
         if positive and not x > 0:
             raise self.error(f"must be positive, got {v!r}", key)

@@ -97,12 +97,11 @@ class FileUnits:
         """``t[key]`` in SI: a plain number in the file's unit of ``dimension`` (or ``implied``: the
         SI factor or conversion of a plain number), or a string with its own unit (not in a
         consistent file)."""
-        if self.consistent and isinstance(t.get(key), str):
-            raise t.error(f"has a unit ({t[key]!r}) but the file's units are 'consistent': give a plain number", key)
         if implied is None:
             ls, fs = self.length_scale, self.force_scale
             implied = {"length": ls, "force": fs, "pressure": fs / ls ** 2, "density": 1.0}[dimension]
-        return t.quantity(key, dimension, default, implied=implied)
+        return t.quantity(key, dimension, default, implied=implied,
+                          unitless="the file's units are 'consistent'" if self.consistent else None)
 
     def pressure(self, t: Table, key: str, default=REQUIRED) -> float:
         """A pressure load in SI (a plain number converted as force / length^2)."""
