@@ -38,7 +38,6 @@ material) as a TOML document.  Example (benchmarks/axisym/hemisphere_ring.toml):
     max_steps = 80
     lam_max = 10.0
 """
-from pathlib import Path
 
 import numpy as np
 

@@ -34,8 +34,14 @@ _TOML_AT = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
 
 
 def closest(word, choices: Iterable[str]) -> str | None:
-    """The choice most like ``word`` (difflib), or None."""
-    hit = difflib.get_close_matches(str(word), sorted(choices), n=1)
+    """The choice most like ``word``, or None: a key with a unit suffix whose stem is a choice
+    (``thickness_mm`` -> ``thickness``: the spelling before units were written as text), else
+    the closest match of difflib."""
+    choices = sorted(choices)
+    stem = str(word).rsplit("_", 1)[0]
+    if "_" in str(word) and stem in choices:
+        return stem
+    hit = difflib.get_close_matches(str(word), choices, n=1)
     return hit[0] if hit else None
 
 
@@ -313,6 +319,17 @@ class Table(Mapping):
         if key not in self.data:
             return v
         return _units.quantity_vector(v, dimension, n, implied, self.where(key))
+
+    def quantity_vectors(self, key: str, dimension: str, n: int = 3, default=REQUIRED, *,
+                         implied=None) -> tuple[tuple[float, ...], ...]:
+        """A list of vector quantities in SI (``["[1.0, 2.0, 3.0] mm", ...]``)."""
+        v = self._raw(key, default)
+        if key not in self.data:
+            return v
+        if not isinstance(v, list):
+            raise self.error(f"must be a list of vectors such as \"[1.0, 2.0, 3.0] mm\", got {v!r}", key)
+        return tuple(_units.quantity_vector(x, dimension, n, implied, f"{self.where(key)} entry {i + 1}")
+                     for i, x in enumerate(v))
 
     def unit(self, key: str, dimension: str, default=REQUIRED) -> tuple[str, float]:
         """A unit name of ``dimension`` and its SI factor (``("mm", 1e-3)``)."""

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import REQUIRED, Table, read_toml, unknown_name
+from ..config import REQUIRED, Table, read_toml
 from ..errors import ConfigError, GraspdefError, ProblemError
 from ..geometry import io as gio
 from ..geometry import primitives as prim
