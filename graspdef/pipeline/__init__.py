@@ -5,7 +5,7 @@ Importing this package is cheap (the command line builds its parser from
 :mod:`graspdef.pipeline.cli_args`); the chain itself loads on first use (PEP 562)."""
 from __future__ import annotations
 
-__all__ = ["GraspRun", "ShellSpec", "grasp_cli", "load_shell_spec", "run_grasp"]
+__all__ = ["GraspRun", "grasp_cli", "run_grasp"]
 
 
 def __getattr__(name: str):
