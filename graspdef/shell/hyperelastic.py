@@ -100,6 +100,18 @@ def _non_negative(name: str, value) -> float:
     return v
 
 
+def _set_mooney_rivlin_constants(mat, name: str) -> None:
+    """Check and set ``mat.C1``, ``mat.C2`` (frozen dataclass): both >= 0, C1 + C2 > 0."""
+    c1 = _non_negative(f"{name} C1", mat.C1)
+    c2 = _non_negative(f"{name} C2", mat.C2)
+    if c1 + c2 <= 0.0:
+        raise ProblemError(
+            f"{name} needs C1 + C2 > 0 (shear modulus mu = 2 (C1 + C2)) with C1, C2 >= 0 "
+            f"for stability, got C1={mat.C1!r}, C2={mat.C2!r}")
+    object.__setattr__(mat, "C1", c1)
+    object.__setattr__(mat, "C2", c2)
+
+
 def _n_thickness(value) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 2:
         raise ProblemError(
@@ -412,14 +424,7 @@ class MooneyRivlin(_Incompressible):
     n_thickness: int = 3
 
     def __post_init__(self) -> None:
-        c1 = _non_negative("Mooney-Rivlin C1", self.C1)
-        c2 = _non_negative("Mooney-Rivlin C2", self.C2)
-        if c1 + c2 <= 0.0:
-            raise ProblemError(
-                f"Mooney-Rivlin needs C1 + C2 > 0 (shear modulus mu = 2 (C1 + C2)) with C1, C2 >= 0 "
-                f"for stability, got C1={self.C1!r}, C2={self.C2!r}")
-        object.__setattr__(self, "C1", c1)
-        object.__setattr__(self, "C2", c2)
+        _set_mooney_rivlin_constants(self, "Mooney-Rivlin")
         object.__setattr__(self, "n_thickness", _n_thickness(self.n_thickness))
 
     @property
@@ -618,13 +623,7 @@ class CompressibleMooneyRivlin(_ThicknessIntegrated):
     n_thickness: int = 3
 
     def __post_init__(self) -> None:
-        c1 = _non_negative("compressible Mooney-Rivlin C1", self.C1)
-        c2 = _non_negative("compressible Mooney-Rivlin C2", self.C2)
-        if c1 + c2 <= 0.0:
-            raise ProblemError(f"compressible Mooney-Rivlin needs C1 + C2 > 0 (shear modulus mu = 2 (C1 + C2)), "
-                               f"got C1={self.C1!r}, C2={self.C2!r}")
-        object.__setattr__(self, "C1", c1)
-        object.__setattr__(self, "C2", c2)
+        _set_mooney_rivlin_constants(self, "compressible Mooney-Rivlin")
         object.__setattr__(self, "lam", _non_negative(
             "compressible Mooney-Rivlin Lame parameter lam (0 <= nu < 1/2)", self.lam))
         object.__setattr__(self, "n_thickness", _n_thickness(self.n_thickness))
