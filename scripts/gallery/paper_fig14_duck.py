@@ -9,9 +9,10 @@ graspdef (scenes/duck: LINEMOD duck scan, CoACD rigid proxy in MuJoCo, control m
 * linear, E = 1 MPa: the indentation is ~230 mm -- meaningless for a 1 mm, 1 MPa wall: the
   paper's values as we read them are far too soft;
 * E calibrated so that the linear shell gives the paper's 8.56 mm (linear scales as 1/E), then
-  the neo-Hookean shell at that E (compressible, nu = 0.45; before the object data stated its law:
-  incompressible): its path stops near 8.9 N (Newton fails past a fold where the
-  side wall under the pin dimples).  NOT reproduced; reported as computed (docs/grasp.md).
+  the neo-Hookean shell at that E (compressible, nu = 0.45): its path stops near 8.6 N (Newton
+  fails past a fold where the side wall under the pin dimples; 8.9 N with the incompressible law
+  every nonlinear run used before the object data stated its law).  NOT reproduced; reported as
+  computed (docs/grasp.md).
 
 Fast mode: the linear run only, on a coarse control mesh (600 faces).  Asserted there: invariants
 of the chain -- each finger pushes with 19.22 N along its axis, the mapped point loads keep the
