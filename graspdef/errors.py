@@ -18,6 +18,12 @@ class ProblemError(GraspdefError):
     """A problem definition (file or object) is invalid."""
 
 
+class ConfigError(ProblemError):
+    """A configuration file or value is invalid: TOML syntax, an unknown or missing key, a value of
+    the wrong type, range or dimension (graspdef.config, graspdef.units).  The message names the
+    file, the table and the key."""
+
+
 class SupportError(GraspdefError):
     """Supports are inconsistent or leave rigid-body modes free."""
 

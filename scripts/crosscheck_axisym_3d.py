@@ -26,7 +26,7 @@ Cases (R = 1, C1 = 1; loads nondimensional as in docs/axisym.md):
    two thickness models from discretisation errors.
 
 Both cases are also solved by the axisymmetric solver with the 3-D solver's thickness model
-(``axisym_material("3d")``, a diagnostic subclass of graspdef.axisym.Material defined here): with
+(``axisym_material("3d")``, a diagnostic subclass of graspdef.axisym.AxisymMaterial defined here): with
 the same shell energy the comparison checks the two solvers; against the thesis's energy it
 includes the O(t/R) difference between the two first-approximation shell theories (about 2 % at
 R/t = 10 for the pinched sphere).  Results and discussion: docs/crosscheck.md.
@@ -60,7 +60,7 @@ def shell3d_thickness_energy(l1, l2, c1, c2, k1, k2, g, n_gauss=3):
     """The 3-D solver's thickness model written in the axisymmetric variables (diagnostic).
 
     Nondimensional (t0 = C1 = 1) energy per unit undeformed area, gradient and Hessian in
-    (l1, l2, c1, c2) = (lambda_xi, lambda_theta, c_xi, c_theta) as Material.shell_energy.  The 3-D
+    (l1, l2, c1, c2) = (lambda_xi, lambda_theta, c_xi, c_theta) as AxisymMaterial.shell_energy.  The 3-D
     solver (graspdef.shell.hyperelastic, Kiendl et al. 2015) uses E_ab(zeta) = e_ab - zeta k_ab with
     k = b - B (covariant) and the mid-surface metric for every layer; in principal axes of an
     axisymmetric state the layer's squared stretches are a = l1^2 - 2 zeta (l1 c1 - k1) and
@@ -97,10 +97,10 @@ def shell3d_thickness_energy(l1, l2, c1, c2, k1, k2, g, n_gauss=3):
 
 
 def _shell3d_material_class():
-    from graspdef.axisym import Material
+    from graspdef.axisym import AxisymMaterial
 
-    class Shell3DThicknessMaterial(Material):
-        """axisym Material with the 3-D solver's thickness model instead of the thesis's phi (diagnostic:
+    class Shell3DThicknessMaterial(AxisymMaterial):
+        """AxisymMaterial with the 3-D solver's thickness model instead of the thesis's phi (diagnostic:
         the same shell energy in both solvers isolates the discretisation/solver difference)."""
 
         def shell_energy(self, l1, l2, c1, c2, k1, k2):
@@ -130,8 +130,8 @@ def _shell3d_material_class():
 def axisym_material(energy: str = "thesis"):
     """The axisymmetric solver's material: energy "thesis" (the thesis's phi, graspdef.axisym as is) or
     "3d" (the 3-D solver's thickness model, diagnostic)."""
-    from graspdef.axisym import Material
-    cls = Material if energy == "thesis" else _shell3d_material_class()
+    from graspdef.axisym import AxisymMaterial
+    cls = AxisymMaterial if energy == "thesis" else _shell3d_material_class()
     return cls("mooney_rivlin", C1=1.0, gamma=GAMMA)
 
 

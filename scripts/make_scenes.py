@@ -1,6 +1,6 @@
 """Generate the MuJoCo grasp scenes in scenes/ from the real scans (issue 5).
 
-    python scripts/make_scenes.py            # rewrites scenes/*/*.xml, assets/*.obj, shell.toml
+    python scripts/make_scenes.py            # rewrites scenes/*/*.xml, assets/*.obj (object.toml is written by hand)
 
 Maintenance script, not imported by graspdef or its tests; its outputs are committed.  Needs
 trimesh (always) and coacd (the duck's convex decomposition; `pip install coacd==1.0.14`).
@@ -8,7 +8,8 @@ trimesh (always) and coacd (the duck's convex decomposition; `pip install coacd=
 Conventions (mujoco_menagerie, ../shared/STYLE.md section 8): the robot file
 scenes/parallel_gripper/parallel_gripper_<tip>.xml holds only the gripper; each scene folder
 holds scene.xml (includes the robot), assets/ (collision meshes, metres, in the scan's own
-frame), shell.toml (the shell model of the object) and README.md.  SI units throughout.
+frame), object.toml (the object's data for graspdef.objects: scan, thickness, material law, gas,
+written by hand with a source for each value) and README.md.  SI units throughout.
 
 Object frame = scan frame: the collision meshes keep the scan's coordinates (metres), and the
 object body is placed so that the chosen grasp point of the scan lies at the world origin, where

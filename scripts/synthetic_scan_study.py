@@ -80,10 +80,10 @@ def load_level(force_n: float) -> float:
 # --------------------------------------------------------------------------------------------
 def reference_meridians(levels) -> list[dict]:
     """Deformed meridian (r, z) [m], pole to equator, and the apex displacement [m] per level."""
-    from graspdef.axisym import Material, pinched_sphere, solve_load
+    from graspdef.axisym import AxisymMaterial, pinched_sphere, solve_load
 
     R, t = 1.0, 1.0 / R_OVER_T
-    model = pinched_sphere(R, t, Material("mooney_rivlin", C1=1.0, gamma=GAMMA), F=t ** 2,
+    model = pinched_sphere(R, t, AxisymMaterial("mooney_rivlin", C1=1.0, gamma=GAMMA), F=t ** 2,
                            contact_radius=RING * R)
     out = []
     for L in levels:

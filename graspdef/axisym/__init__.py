@@ -1,6 +1,8 @@
 """Finite axisymmetric deformation of thin hyperelastic shells of revolution (the thesis's method).
 
-Independent of the 3-D subdivision solver: it imports only numpy, scipy and graspdef.errors.
+Independent of the 3-D subdivision solver: it imports only numpy, scipy, graspdef.errors and (for its problem
+files) graspdef.config / graspdef.units.  Its names are distinct from the 3-D solver's (AxisymMaterial,
+AxisymEquilibrium, load_axisym_problem).
 
 Nondimensionalisation (thesis 2.81, derived in docs/axisym.md): lengths / t0 (rho = r/t0, eps = z/t0,
 sigma = s0/t0), stresses and distributed loads / C1, stress resultants per unit length / (t0 C1), couples per
@@ -18,14 +20,14 @@ Modules, one concern each:
     problems      ready-made problems (the thesis's hemispheres, pinched and inflated spheres)
     bench         ``run_axisym_bench`` comparison records
 """
-from .material import Material
+from .material import AxisymMaterial
 from .assembly import Model, Node, Segment, NodalLoad, DistributedLoad
-from .continuation import PathResult, Equilibrium, solve_path, solve_load
+from .continuation import PathResult, AxisymEquilibrium, solve_path, solve_load
 from .problems import hemisphere_example, pinched_sphere, inflated_sphere, sphere_apex_curve
-from .config import load_problem
+from .config import load_axisym_problem
 
 __all__ = [
-    "Material", "Model", "Node", "Segment", "NodalLoad", "DistributedLoad", "PathResult", "Equilibrium",
+    "AxisymMaterial", "Model", "Node", "Segment", "NodalLoad", "DistributedLoad", "PathResult", "AxisymEquilibrium",
     "solve_path", "solve_load", "hemisphere_example", "pinched_sphere", "inflated_sphere", "sphere_apex_curve",
-    "load_problem",
+    "load_axisym_problem",
 ]

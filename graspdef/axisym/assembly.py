@@ -17,7 +17,7 @@ import numpy as np
 from graspdef.errors import ProblemError, SupportError
 
 from . import meridian
-from .material import Material
+from .material import AxisymMaterial
 
 TWO_PI = 2.0 * np.pi
 
@@ -81,7 +81,7 @@ class Model:
     by the load factor Lam), discretisation controls (max_piece: longest shooting piece in units of t0;
     rk_steps: RK4 steps per piece)."""
 
-    material: Material
+    material: AxisymMaterial
     thickness: float
     nodes: list
     segments: list

@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from .continuation import solve_load, solve_path
-from .material import Material
+from .material import AxisymMaterial
 from .problems import hemisphere_example, inflated_sphere, pinched_sphere
 
 #: the thesis's Chapter 4 numbers
@@ -53,7 +53,7 @@ def reissner_point_load(R_over_t=300.0, contact=0.1):
 
     Reissner (1946) / ../shared/BENCHMARKS.md 2.4: delta = sqrt(3 (1 - nu^2)) F R / (4 E t^2), nu = 1/2,
     E = 3 mu = 6 (C1 + C2).  Load chosen so that delta = 0.01 t (linear range)."""
-    mat = Material("mooney_rivlin", C1=1.0e5, gamma=0.1)
+    mat = AxisymMaterial("mooney_rivlin", C1=1.0e5, gamma=0.1)
     R, t = 1.0, 1.0 / R_over_t
     E = 3.0 * mat.mu
     F = 0.01 * t * E * t * t / (0.375 * R)
@@ -65,7 +65,7 @@ def reissner_point_load(R_over_t=300.0, contact=0.1):
 def balloon_pmax(R_over_t=20.0, gamma=0.1):
     """Maximum inflation pressure p_max R0/(C1 t0) of a Mooney-Rivlin sphere (BENCHMARKS.md 4.2: 2.98124 for
     gamma = 0.1, membrane theory; bending adds O((t/R)^2))."""
-    mat = Material("mooney_rivlin", C1=1.0, gamma=gamma)
+    mat = AxisymMaterial("mooney_rivlin", C1=1.0, gamma=gamma)
     m = inflated_sphere(1.0, 1.0 / R_over_t, mat, p=1.0 / R_over_t, max_piece=0.4)
     path = solve_path(m, ds=10.0, ds_max=100.0, max_steps=80, unload_fraction=0.999, on_failure="stop")
     return path.limits[0]["lam"] if path.limits else float("nan")

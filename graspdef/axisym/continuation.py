@@ -25,7 +25,7 @@ from .shooting import ShootingError, end_forces, mismatch, solve_bvp1, stiffness
 
 
 @dataclass
-class Equilibrium:
+class AxisymEquilibrium:
     """A converged equilibrium (nondimensional).  x: dof vector (nodes' rho, eps, phi); nodes: (nnodes, 3) table
     with the pole nodes' eps filled in; lam: load factor; shape: (npts, 3) deformed meridian (rho, eps, phi) in
     meridian order; K_ff: free-free stiffness; n_negative / det_sign: stability data; reactions at fixed dofs."""
@@ -61,7 +61,7 @@ class PathResult:
         return np.array([p.nodes[k] for p in self.points])
 
 
-class State:
+class AxisymState:
     """Current equilibrium iterate of a Discrete model: x, lam, shooting unknowns u and the last solution."""
 
     def __init__(self, disc):
@@ -74,7 +74,7 @@ class State:
         self.R0 = np.zeros(disc.ndof)  # residual of the unloaded, undeformed discrete model (see reference())
 
     def copy(self):
-        s = State.__new__(State)
+        s = AxisymState.__new__(AxisymState)
         s.d, s.x, s.lam, s.u = self.d, self.x.copy(), self.lam, self.u.copy()
         s.store = {"strains": None if self.store.get("strains") is None else self.store["strains"].copy()}
         s.sol, s.R0, s.mis = self.sol, self.R0, getattr(self, "mis", 0.0)
@@ -168,7 +168,7 @@ class State:
         F, _, _ = d.assemble(sol["P"])
         reactions = (F - self.R0 - self.lam * d.Pref)[d.fixed]
         asym = float(np.max(np.abs(Kff - Kff.T)) / max(np.max(np.abs(Kff)), 1e-300))
-        return Equilibrium(lam=self.lam, x=self.x.copy(), nodes=X, shape=shape, n_negative=int(np.sum(ev < 0)),
+        return AxisymEquilibrium(lam=self.lam, x=self.x.copy(), nodes=X, shape=shape, n_negative=int(np.sum(ev < 0)),
                            det_sign=float(sign), iterations=iterations, reactions=reactions,
                            K_ff=Kff if keep_K else None, asym=asym)
 
@@ -190,7 +190,7 @@ def _tolerances(d, lam, R):
 def solve_load(model, lam, increments=1, tol=None, maxit=25):
     """Load-controlled Newton (no limit points): equilibrium at load factor lam reached in equal increments."""
     d = model.build()
-    st = State(d)
+    st = AxisymState(d)
     R, K, dR = st.reference()
     f = d.free
     its = 0
@@ -230,7 +230,7 @@ def solve_path(model, ds=0.5, max_steps=200, stop=None, ds_max=None, ds_min=1e-6
     Returns a PathResult.  Never returns an unconverged point."""
     t_start = time.perf_counter()
     d = model.build()
-    st = State(d)
+    st = AxisymState(d)
     R, K, dR = st.reference()
     f = d.free
     Kff = K[np.ix_(f, f)]

@@ -26,7 +26,7 @@ KINDS = ("mooney_rivlin", "exponential")
 
 
 @dataclass(frozen=True)
-class Material:
+class AxisymMaterial:
     """Incompressible hyperelastic material.
 
     kind: "mooney_rivlin" or "exponential"; C1 in Pa (the stress unit of the nondimensionalisation);

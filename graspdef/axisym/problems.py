@@ -11,7 +11,7 @@ from graspdef.errors import ProblemError
 
 from .assembly import DistributedLoad, Model, Node, NodalLoad, Segment
 from .continuation import solve_path
-from .material import Material
+from .material import AxisymMaterial
 
 
 def _sphere_nodes(R, angles, fix_edge):
@@ -31,7 +31,7 @@ def hemisphere_example(case, R_over_t=10.0, gamma=0.1, ring_angle=np.pi / 6, max
     that reproduces the thesis's limit load 3.363; edge_sense=+1 turns it outward),
     "ring" (downward unit ring force per radian at polar angle ring_angle), "uniform" (downward uniform vertical
     load of unit intensity per unit deformed area, or undeformed area with load_basis="reference")."""
-    mat = Material("mooney_rivlin", C1=1.0, gamma=gamma, volume_factor=volume_factor)
+    mat = AxisymMaterial("mooney_rivlin", C1=1.0, gamma=gamma, volume_factor=volume_factor)
     R = float(R_over_t)
     angles = [0.0, np.pi / 2] if case != "ring" else [0.0, ring_angle, np.pi / 2]
     nodes = _sphere_nodes(R, angles, (False, True, False))
@@ -77,7 +77,7 @@ def pinched_sphere(R, t, material, F=1.0, contact_radius=None, rk_steps=2, max_p
     By symmetry the upper hemisphere is modelled: equator node with z and phi held, r free.  A point force on
     the axis is singular in shell theory, so each force is applied as a ring load on the circle of undeformed radius
     contact_radius (default t/4) around the pole; as contact_radius -> 0 the pole displacement converges (Reissner).
-    Load factor Lam multiplies F.  The apex (pole) displacement is ``nodes[0, 1] * t - R`` (Equilibrium.nodes is
+    Load factor Lam multiplies F.  The apex (pole) displacement is ``nodes[0, 1] * t - R`` (AxisymEquilibrium.nodes is
     nondimensional)."""
     a = contact_radius if contact_radius is not None else 0.25 * t
     if not 0 < a < 0.5 * R:

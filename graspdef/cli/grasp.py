@@ -18,8 +18,10 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                          "penetration-free obstacles (contact area grows with the load)")
     ap.add_argument("--analysis", choices=["linear", "nonlinear"], default="nonlinear")
     ap.add_argument("--gas", choices=["auto", "on", "off"], default="auto",
-                    help="enclosed air: auto = shell.toml's (nonlinear only), on (80 kPa if none given), off")
-    ap.add_argument("--E-MPa", dest="E_MPa", type=float, help="override shell.toml's Young's modulus [MPa]")
+                    help="enclosed air: auto = object.toml's [gas] (nonlinear only), on (object.toml's [gas] p0; "
+                         "an error if it has none), off")
+    ap.add_argument("--E-MPa", dest="E_MPa", type=float,
+                    help="override the Young's modulus of object.toml's material law [MPa]")
     ap.add_argument("--out", required=True, help="run folder to write (replaced if it exists)")
 
 
@@ -28,7 +30,9 @@ def run(a: argparse.Namespace) -> int:
     from ..pipeline.grasp import run_grasp
 
     gas = {"auto": None, "on": True, "off": False}[a.gas]
-    E = None if getattr(a, "E_MPa", None) is None else a.E_MPa * 1e6
+    from ..units import quantity
+
+    E = None if getattr(a, "E_MPa", None) is None else quantity(a.E_MPa, "pressure", implied="MPa", what="--E-MPa")
     run = run_grasp(a.scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E)
     r = run.result
     fb = r["feedback"]

@@ -9,33 +9,15 @@ import tempfile
 from collections.abc import Mapping
 from os import PathLike
 from pathlib import Path
-from types import MappingProxyType
 
 import numpy as np
 import trimesh
 
 from graspdef.errors import MeshError, ProblemError
 from graspdef.geometry.mesh import TriMesh
-
-#: Length of one unit in metres.
-LENGTH_UNITS: Mapping[str, float] = MappingProxyType(
-    {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "in": 0.0254})
+from graspdef.units import LENGTH_UNITS, length_scale  # noqa: F401  (re-exported: the tables live in graspdef.units)
 
 _PROPERTY_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-
-
-def length_scale(units: str) -> float:
-    """Length of one ``units`` in metres.
-
-    Raises
-    ------
-    ProblemError
-        If ``units`` is not a key of :data:`LENGTH_UNITS`.
-    """
-    if not isinstance(units, str) or units not in LENGTH_UNITS:
-        raise ProblemError(f"unknown length unit {units!r}; valid units are "
-                           + ", ".join(LENGTH_UNITS))
-    return LENGTH_UNITS[units]
 
 
 def _declared_face_count(path: Path) -> int | None:

@@ -4,7 +4,7 @@ nonlinear shell solve -> run folder (graspdef.pipeline.grasp).
 Importing this package is cheap; the chain itself loads on first use (PEP 562)."""
 from __future__ import annotations
 
-__all__ = ["GraspRun", "ShellSpec", "load_shell_spec", "run_grasp"]
+__all__ = ["GraspRun", "run_grasp"]
 
 
 def __getattr__(name: str):

@@ -2,9 +2,9 @@
 
 The chain (issue 5):
 
-1. read the scene's ``shell.toml`` (object body, scan, thickness, material, gas, supports) and
-   build the shell: control mesh of the scan (graspdef.scans.control_mesh), offset inward by
-   t/2 (mid_surface);
+1. read the object's data (``object.toml`` beside the scene: body, scan, thickness, material law,
+   gas, supports; graspdef.objects) and build the shell: control mesh of the scan
+   (graspdef.scans.control_mesh), offset inward by t/2 (mid_surface);
 2. MuJoCo: close the gripper until each finger presses with the target force, settle, extract
    the contacts and the object's pose (graspdef.sim.grasp);
 3. contacts -> object frame -> point loads on the limit surface keeping total force and moment
@@ -12,7 +12,7 @@ The chain (issue 5):
    balance to MuJoCo's settling accuracy; the residual net force and moment are reported;
 4. a free object is held only by the fingers: its rigid-body modes are removed by
    RigidModes (a statically determinate 3-2-1 support in nonlinear solves, whose reactions
-   are the residual); a fixed object (the duck-head poke) by point supports from shell.toml;
+   are the residual); a fixed object (the duck-head poke) by point supports from object.toml;
 5. linear or nonlinear solve; the indentation (approach of the contact points) is fed back:
    predicted finger gap = rigid-proxy gap - approach, mismatch against MuJoCo's gap reported;
 6. the run folder, written atomically: result.json, contacts.json, deformed.ply,
@@ -24,98 +24,25 @@ import csv
 import json
 import logging
 import time
-import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..contact.mapping import map_contacts
-from ..errors import GraspdefError, ProblemError
+from ..errors import ProblemError
 from ..geometry.io import atomic_folder, save_ply
 from ..geometry.provenance import write_provenance
+from ..objects import build_shell, load_object, scene_xml
 from ..problem.loads import BodyForce
 from ..problem.potentials import EnclosedGas
 from ..problem.problem import Problem
 from ..problem.supports import PointSupport, RigidModes
-from ..scans import control_mesh, load_scan, mid_surface
-from ..shell.hyperelastic import NeoHookean
-from ..shell.materials import LinearElastic
-from ..shell.model import Shell
 from ..sim.grasp import GraspSettings, grasp
 from ..solve.linear import solve_linear
 from ..solve.nonlinear import PathOptions, PathStopped, solve_nonlinear
 
 log = logging.getLogger(__name__)
-SCENES = Path(__file__).resolve().parents[2] / "scenes"
-
-
-@dataclass(frozen=True)
-class ShellSpec:
-    """A scene's shell.toml, in SI."""
-
-    folder: Path
-    body: str
-    scan: str
-    scene: str
-    thickness: float
-    E: float
-    nu: float
-    control_faces: int
-    remesh: str
-    gas_p0: float
-    fingers: tuple[str, ...]
-    fixed_points: tuple[tuple[float, float, float], ...]
-    steps: int
-    raw: dict = field(default_factory=dict)
-
-    def material(self, analysis: str):
-        if analysis == "linear":
-            return LinearElastic(self.E, self.nu)
-        if abs(self.nu - 0.5) > 1e-9:
-            log.info("neo-Hookean shells are incompressible (nu = 0.5); E = %g Pa gives mu = E/3", self.E)
-        return NeoHookean(self.E / 3.0)
-
-
-def resolve_scene(scene: str | Path) -> Path:
-    """A scene folder, its scene*.xml, or a name under scenes/ -> the scene XML path."""
-    p = Path(scene)
-    if p.is_dir():
-        p = p / "scene.xml"
-    elif not p.exists() and (SCENES / str(scene)).is_dir():
-        p = SCENES / str(scene) / "scene.xml"
-    if not p.is_file():
-        raise ProblemError(f"scene not found: {scene} (give a scene.xml, its folder, or a name in {SCENES})")
-    return p
-
-
-def load_shell_spec(scene_xml: Path) -> ShellSpec:
-    f = scene_xml.parent / "shell.toml"
-    if not f.is_file():
-        raise ProblemError(f"{scene_xml.parent}: no shell.toml beside the scene (the object's shell model)")
-    try:
-        t = tomllib.loads(f.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ProblemError(f"{f}: {exc}") from exc
-    try:
-        o, s, m = t["object"], t["shell"], t["material"]
-        return ShellSpec(scene_xml.parent, o["body"], o["scan"], scene_xml.name, float(s["thickness_mm"]) * 1e-3,
-                         float(m["E_MPa"]) * 1e6, float(m["nu"]), int(s.get("control_faces", 1280)),
-                         s.get("remesh", "auto"), float(t.get("gas", {}).get("p0_kPa", 0.0)) * 1e3,
-                         tuple(t.get("grasp", {}).get("fingers", ["left", "right"])),
-                         tuple(tuple(float(v) * 1e-3 for v in p) for p in t.get("supports", {}).get("fixed_points_mm", [])),
-                         int(t.get("solver", {}).get("steps", 8)), t)
-    except (KeyError, TypeError, ValueError) as exc:
-        raise ProblemError(f"{f}: missing or bad entry {exc}") from exc
-
-
-def build_shell(spec: ShellSpec, analysis: str) -> tuple[Shell, dict]:
-    scan = load_scan(spec.scan)
-    outer, rep = control_mesh(scan, spec.control_faces, spec.remesh, relax=int(spec.raw.get("shell", {}).get("relax", 0)))
-    mid = mid_surface(outer, spec.thickness)
-    return Shell(mid.vertices, mid.faces, spec.material(analysis), spec.thickness), {
-        "scan": spec.scan, "control_faces": int(len(mid.faces)), "control_vertices": int(len(mid.vertices)),
-        "remesh": getattr(rep, "method", spec.remesh)}
 
 
 @dataclass
@@ -145,8 +72,9 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     """Run the whole chain for ``scene`` at ``force`` [N] per finger; write the run folder ``out``
     (when given) and return its result record.
 
-    ``gas``: None = as shell.toml says; False/True forces the enclosed air off/on (80 kPa gauge
-    when shell.toml has none).  ``E`` [Pa]: overrides shell.toml's Young's modulus."""
+    ``gas``: None = as object.toml says (nonlinear only); False/True forces the enclosed air off/on
+    (on: object.toml's [gas] p0; an error if it gives none).  ``E`` [Pa]: overrides the Young's
+    modulus of object.toml's material law."""
     t0 = time.perf_counter()
     if contact not in ("point", "geometric"):
         raise ProblemError(f"contact must be 'point' (the paper's point loads) or 'geometric' (rigid fingertips), "
@@ -155,18 +83,21 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
         raise ProblemError(f"analysis must be 'linear' or 'nonlinear', got {analysis!r}")
     if not np.isfinite(force) or force <= 0:
         raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
-    xml = resolve_scene(scene)
-    spec = load_shell_spec(xml)
+    xml = scene_xml(scene)
+    spec = load_object(xml)
     if control_faces:
-        spec = ShellSpec(**{**spec.__dict__, "control_faces": int(control_faces)})
+        spec = spec.replace(control_faces=int(control_faces))
     if E is not None:
         if not (np.isfinite(E) and E > 0):
             raise ProblemError(f"E must be a positive number of pascals, got {E!r}")
-        spec = ShellSpec(**{**spec.__dict__, "E": float(E)})
-    if gas is None:     # shell.toml's air; a linear shell cannot hold it (p V = const), so none there
-        p0 = spec.gas_p0 if analysis == "nonlinear" else 0.0
+        spec = spec.replace(E=float(E))
+    if gas and spec.gas is None:
+        raise ProblemError(f"{spec.file}: gas on, but the object has no enclosed air: give [gas] p0 (gauge "
+                           "pressure) with its source")
+    if gas is None:     # the object's air; a linear shell cannot hold it (p V = const), so none there
+        p0 = spec.gas.p0 if spec.gas is not None and analysis == "nonlinear" else 0.0
     else:
-        p0 = (spec.gas_p0 or 80e3) if gas else 0.0
+        p0 = spec.gas.p0 if gas else 0.0
     t_setup = time.perf_counter()
     shell, shell_info = build_shell(spec, analysis)
     t_shell = time.perf_counter()
@@ -197,9 +128,9 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
             sp = pr0.locate(p, f"fixed point {i}", tol=5e-3)
             supports.append(PointSupport(sp.face, sp.bary, name=f"fixed_{i}"))
         if not supports:
-            raise ProblemError(f"{spec.folder}/shell.toml: a fixed object needs [supports] fixed_points_mm")
+            raise ProblemError(f"{spec.file}: a fixed object needs [supports] fixed_points")
     if p0 > 0:
-        loads.append(EnclosedGas(p0))
+        loads.append(EnclosedGas(p0) if spec.gas.p_atm is None else EnclosedGas(p0, spec.gas.p_atm))
     probes = {}
     for s in sorted(set(mapping.finger)):
         idx = [i for i, f in enumerate(mapping.finger) if f == s]
@@ -293,8 +224,8 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
         residual_F = residual_F + sum(np.asarray(r.get("contact_force_N", np.zeros(3))) for r in geo.values())
     rec = {
         "scene": str(xml), "object": spec.body, "force_N": force, "contact": contact, "analysis": analysis,
-        "material": {"model": "linear_elastic" if analysis == "linear" else "neo_hookean", "E_Pa": spec.E,
-                     "nu": spec.nu if analysis == "linear" else 0.5, "thickness_m": spec.thickness},
+        "material": {"model": spec.material.model(analysis), "E_Pa": spec.material.E, "nu": spec.material.nu,
+                     "thickness_m": spec.thickness},
         "gas_p0_Pa": p0, "shell": shell_info,
         "max_displacement_m": float(np.linalg.norm(u_def, axis=1).max()),
         "max_displacement_raw_m": float(np.linalg.norm(u_lim, axis=1).max()),
@@ -329,7 +260,7 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
         out = Path(out)
         config = {"scene": str(scene), "force_N": force, "contact": contact, "analysis": analysis, "gas": gas,
                   "control_faces": control_faces, "steps": steps, "E_Pa": E, "settings": dict(settings.__dict__),
-                  "shell_toml": (spec.folder / "shell.toml").read_text()}
+                  "object_toml": spec.file.read_text()}
         _write(out, rec, g, sol, x_lim, u_def, config)
     return GraspRun(Path(out) if out is not None else None, rec)
 

@@ -29,7 +29,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from graspdef.errors import GraspdefError
-from graspdef.geometry import LENGTH_UNITS, TriMesh
+from graspdef.geometry import TriMesh
+from graspdef.units import LENGTH_UNITS
 
 #: Fewest scan points registration accepts.
 MIN_POINTS = 100

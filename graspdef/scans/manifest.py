@@ -9,7 +9,6 @@ manifest by :func:`graspdef.scans.scanner.generate_scan` and written under ``out
 from __future__ import annotations
 
 import os
-import tomllib
 from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
@@ -17,8 +16,10 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from graspdef.config import Table, read_toml
 from graspdef.errors import MeshError, ProblemError
-from graspdef.geometry import LENGTH_UNITS, TriMesh, length_scale
+from graspdef.geometry import TriMesh
+from graspdef.units import length_scale
 
 #: Repository root (the folder holding ``scans/manifest.toml``).
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -28,6 +29,8 @@ MANIFEST_PATH = REPO_ROOT / "scans" / "manifest.toml"
 SHARED_SCANS_ENV = "GRASPDEF_SHARED_SCANS"
 
 _REQUIRED_REAL = ("path", "units", "frame", "licence", "source")
+#: the keys a real scan's entry (or a [defaults.<name>] table) may hold
+_REAL_KEYS = _REQUIRED_REAL + ("origin", "blob", "citation", "kind", "bytes", "licence_file")
 
 
 @dataclass(frozen=True)
@@ -41,7 +44,7 @@ class ScanEntry:
     path : str
         File path relative to the shared scans folder.
     units : str
-        Length unit of the coordinates in the file (a key of ``LENGTH_UNITS``).
+        Length unit of the coordinates in the file (a key of ``graspdef.units.LENGTH_UNITS``).
     frame, licence, source : str
         Coordinate-frame note, licence identifier and source URL.
     extra : dict
@@ -88,39 +91,40 @@ def shared_scans_dir(override: str | PathLike | None = None) -> Path:
 
 
 def load_manifest(path: str | PathLike = MANIFEST_PATH) -> Manifest:
-    """Read and check the manifest.
+    """Read and check the manifest (with :mod:`graspdef.config`).
 
     Raises
     ------
     ProblemError
-        If the file is missing or not TOML, an entry lacks one of path, units, frame, licence,
-        source, or names an unknown unit or defaults table.
+        If the file is missing or not TOML, holds an unknown key, an entry lacks one of path,
+        units, frame, licence, source, or names an unknown unit, defaults table or recipe key;
+        the message names the file, the table and the key.
     """
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise ProblemError(f"scan manifest not found: {path}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ProblemError(f"{path}: not valid TOML: {exc}") from None
-    defaults = data.get("defaults", {})
+    from graspdef.scans.scanner import RECIPE_KEYS
+
+    doc = read_toml(path, "scan manifest")
+    doc.check({"schema", "defaults", "real", "generated"})
+    doc.integer("schema", 1, minimum=1)
+    defaults = doc.table("defaults", required=False).children()
+    for d in defaults.values():
+        d.check(_REAL_KEYS)
     real = {}
-    for sid, raw in data.get("real", {}).items():
-        entry = dict(raw)
-        if "defaults" in entry:
-            name = entry.pop("defaults")
-            if name not in defaults:
-                raise ProblemError(f"{path}: real.{sid} uses unknown defaults table {name!r}")
-            entry = {**defaults[name], **entry}
-        missing = [k for k in _REQUIRED_REAL if k not in entry]
-        if missing:
-            raise ProblemError(f"{path}: real.{sid} lacks {', '.join(missing)}")
-        if entry["units"] not in LENGTH_UNITS:
-            raise ProblemError(f"{path}: real.{sid} has unknown units {entry['units']!r}")
-        real[sid] = ScanEntry(sid, *(str(entry.pop(k)) for k in _REQUIRED_REAL), extra=entry)
-    gen = data.get("generated", {})
-    recipes = {k: dict(v) for k, v in gen.items() if isinstance(v, dict)}
-    return Manifest(real, recipes, REPO_ROOT / gen.get("directory", "out/scans"))
+    for sid, raw in doc.table("real", required=False).children().items():
+        raw.check(_REAL_KEYS + ("defaults",))
+        base = defaults[raw.string("defaults", choices=defaults)].data if "defaults" in raw else {}
+        entry = Table({**base, **{k: v for k, v in raw.items() if k != "defaults"}}, raw.source, raw.name)
+        entry.check(_REAL_KEYS, _REQUIRED_REAL)
+        units = entry.unit("units", "length")[0]
+        real[sid] = ScanEntry(sid, entry.string("path"), units, entry.string("frame"), entry.string("licence"),
+                              entry.string("source"),
+                              extra={k: v for k, v in entry.items() if k not in _REQUIRED_REAL})
+    gen = doc.table("generated", required=False)
+    recipes = {}
+    for rid, recipe in Table({k: v for k, v in gen.items() if k != "directory"}, gen.source,
+                             gen.name).children().items():
+        recipe.check(RECIPE_KEYS, ("source",))
+        recipes[rid] = dict(recipe)
+    return Manifest(real, recipes, REPO_ROOT / gen.string("directory", "out/scans"))
 
 
 def scan_entry(scan_id: str, manifest: Manifest | None = None) -> ScanEntry:

@@ -28,7 +28,7 @@ import datetime
 import hashlib
 import json
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from os import PathLike
 from pathlib import Path
 
@@ -299,6 +299,14 @@ def scan_surface(mesh: TriMesh, scanner: Scanner = Scanner(), seed: int = 0,
     return SyntheticScan(pts, view, pose, provenance, faces)
 
 
+#: recipe keys given in millimetres (scans/manifest.toml) -> Scanner settings in metres
+_RECIPE_MM = {"sigma_mm": "sigma", "hole_radius_mm": "hole_radius", "distance_mm": "distance",
+              "max_translation_mm": "max_translation"}
+#: the keys a generated-scan recipe ([generated.<id>] of the manifest) may hold
+RECIPE_KEYS = ("source", "seed", "triangulate") + tuple(sorted(
+    ({f.name for f in fields(Scanner)} - set(_RECIPE_MM.values())) | set(_RECIPE_MM)))
+
+
 def write_scan(scan: SyntheticScan, path: str | PathLike, units: str = "m") -> Path:
     """Write the scan as a PLY point cloud or mesh (``comment units``; per-point ``view``) and
     its provenance as ``<stem>.provenance.json`` next to it.  Returns the PLY path."""
@@ -342,10 +350,8 @@ def generate_scan(scan_id: str, manifest=None, out_dir: str | PathLike | None = 
     triangulate = bool(recipe.pop("triangulate", False))
     settings = {}
     for key, value in recipe.items():
-        if key.endswith("_mm"):
-            settings[{"sigma_mm": "sigma", "hole_radius_mm": "hole_radius",
-                      "distance_mm": "distance", "max_translation_mm": "max_translation"}
-                     [key]] = value * 1e-3
+        if key in _RECIPE_MM:
+            settings[_RECIPE_MM[key]] = value * 1e-3
         else:
             settings[key] = value
     scanner = Scanner(**settings)

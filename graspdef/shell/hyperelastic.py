@@ -29,7 +29,6 @@ material from a name and a parameter table, for problem files.
 """
 from __future__ import annotations
 
-import difflib
 import functools
 import math
 from collections.abc import Mapping
@@ -37,7 +36,8 @@ from dataclasses import MISSING, dataclass, fields
 
 import numpy as np
 
-from ..errors import ProblemError, SolverError
+from ..config import check_names, unknown_name
+from ..errors import ConfigError, ProblemError, SolverError
 from ._kernels import (
     COMPRESSIBLE_NEO_HOOKEAN,
     EXPONENTIAL,
@@ -47,7 +47,7 @@ from ._kernels import (
 )
 from .materials import LinearElastic
 
-__all__ = ["NeoHookean", "MooneyRivlin", "Exponential", "CompressibleNeoHookean",
+__all__ = ["NeoHookean", "MooneyRivlin", "Exponential", "CompressibleNeoHookean", "CompressibleMooneyRivlin",
            "in_plane_invariants", "MATERIALS", "PARAMETERS", "make_material"]
 
 #: d^2 d / dv^2 for v = (E11, E22, 2 E12), divided by det(A^ab): d = c - 1 + det(A^-1)(4 v1 v2 - v3^2)
@@ -98,6 +98,18 @@ def _non_negative(name: str, value) -> float:
     if v < 0.0:
         raise ProblemError(f"{name} must be >= 0, got {value!r}")
     return v
+
+
+def _set_mooney_rivlin_constants(mat, name: str) -> None:
+    """Check and set ``mat.C1``, ``mat.C2`` (frozen dataclass): both >= 0, C1 + C2 > 0."""
+    c1 = _non_negative(f"{name} C1", mat.C1)
+    c2 = _non_negative(f"{name} C2", mat.C2)
+    if c1 + c2 <= 0.0:
+        raise ProblemError(
+            f"{name} needs C1 + C2 > 0 (shear modulus mu = 2 (C1 + C2)) with C1, C2 >= 0 "
+            f"for stability, got C1={mat.C1!r}, C2={mat.C2!r}")
+    object.__setattr__(mat, "C1", c1)
+    object.__setattr__(mat, "C2", c2)
 
 
 def _n_thickness(value) -> int:
@@ -412,14 +424,7 @@ class MooneyRivlin(_Incompressible):
     n_thickness: int = 3
 
     def __post_init__(self) -> None:
-        c1 = _non_negative("Mooney-Rivlin C1", self.C1)
-        c2 = _non_negative("Mooney-Rivlin C2", self.C2)
-        if c1 + c2 <= 0.0:
-            raise ProblemError(
-                f"Mooney-Rivlin needs C1 + C2 > 0 (shear modulus mu = 2 (C1 + C2)) with C1, C2 >= 0 "
-                f"for stability, got C1={self.C1!r}, C2={self.C2!r}")
-        object.__setattr__(self, "C1", c1)
-        object.__setattr__(self, "C2", c2)
+        _set_mooney_rivlin_constants(self, "Mooney-Rivlin")
         object.__setattr__(self, "n_thickness", _n_thickness(self.n_thickness))
 
     @property
@@ -584,6 +589,131 @@ class CompressibleNeoHookean(_ThicknessIntegrated):
 
 
 # ------------------------------------------------------------------------------------------------
+# compressible Mooney-Rivlin: C33 from plane stress
+# ------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class CompressibleMooneyRivlin(_ThicknessIntegrated):
+    """Compressible Mooney-Rivlin shell material with a plane-stress through-thickness stretch.
+
+    ``psi = C1 (I1 - 3 - 2 ln J) + C2 (I2/J^2 - 3 + 2 ln J) + lam/2 (ln J)^2`` per unit rest
+    volume (``I2/J^2 = tr C^-1``).  At J = 1 it is the incompressible Mooney-Rivlin law
+    ``C1 (I1 - 3) + C2 (I2 - 3)``; the C2 term adds no volumetric stiffness, so at small strain it is
+    LinearElastic(E, nu) with the Lame parameters (lam, mu = 2 (C1 + C2)), exactly as
+    :class:`CompressibleNeoHookean` (which it is for C2 = 0, mu = 2 C1).  With the in-plane
+    invariants c, d and ``z = C33``: ``I1 = c + z``, ``tr C^-1 = c/d + 1/z``, ``J^2 = d z``.
+    ``z`` solves ``dpsi/dz = 0``, i.e. ``f(u) = 4 C1 (e^u - 1) + 4 C2 (1 - e^-u) + lam (ln d + u) = 0``
+    in ``u = ln z`` (f increasing, its root between 0 and -ln d: Newton safeguarded by bisection,
+    converged to round-off); the reduced energy's derivatives follow from the envelope theorem
+    (first) and static condensation (second).
+
+    Parameters
+    ----------
+    C1, C2 : float
+        Material constants [Pa], both >= 0 with ``C1 + C2 > 0``; small-strain shear modulus
+        ``mu = 2 (C1 + C2)``.
+    lam : float
+        First Lame parameter [Pa], >= 0 (0 <= nu < 1/2; use MooneyRivlin for nu = 1/2).
+    n_thickness : int, optional
+        Gauss-Legendre points through the thickness (default 3, at least 2).
+    """
+
+    C1: float
+    C2: float
+    lam: float
+    n_thickness: int = 3
+
+    def __post_init__(self) -> None:
+        _set_mooney_rivlin_constants(self, "compressible Mooney-Rivlin")
+        object.__setattr__(self, "lam", _non_negative(
+            "compressible Mooney-Rivlin Lame parameter lam (0 <= nu < 1/2)", self.lam))
+        object.__setattr__(self, "n_thickness", _n_thickness(self.n_thickness))
+
+    @classmethod
+    def from_E_nu(cls, E: float, nu: float, c2_over_c1: float, n_thickness: int = 3) -> "CompressibleMooneyRivlin":
+        """From the small-strain Young's modulus E [Pa] > 0, Poisson's ratio 0 <= nu < 1/2 and the
+        ratio C2/C1 >= 0: mu = E / (2 (1 + nu)) = 2 (C1 + C2), lam = E nu / ((1 + nu)(1 - 2 nu))."""
+        E = _positive("compressible Mooney-Rivlin Young's modulus E", E)
+        nu = _number("compressible Mooney-Rivlin Poisson's ratio nu", nu)
+        r = _non_negative("compressible Mooney-Rivlin ratio C2/C1", c2_over_c1)
+        if not 0.0 <= nu < 0.5:
+            raise ProblemError(
+                f"compressible Mooney-Rivlin Poisson's ratio nu must lie in [0, 0.5), got {nu!r} "
+                f"(nu = 0.5 is incompressible: use mooney_rivlin)")
+        mu = E / (2.0 * (1.0 + nu))
+        c1 = mu / (2.0 * (1.0 + r))
+        return cls(C1=c1, C2=r * c1, lam=E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), n_thickness=n_thickness)
+
+    @property
+    def mu(self) -> float:
+        """Small-strain shear modulus 2 (C1 + C2) [Pa]."""
+        return 2.0 * (self.C1 + self.C2)
+
+    @property
+    def E(self) -> float:
+        """Small-strain Young's modulus mu (3 lam + 2 mu)/(lam + mu) [Pa]."""
+        mu = self.mu
+        return mu * (3.0 * self.lam + 2.0 * mu) / (self.lam + mu)
+
+    @property
+    def nu(self) -> float:
+        """Small-strain Poisson's ratio lam / (2 (lam + mu)) [-]."""
+        return self.lam / (2.0 * (self.lam + self.mu))
+
+    def _log_c33(self, log_d: np.ndarray) -> np.ndarray:
+        """u = ln C33 solving f(u) = 4 C1 expm1(u) - 4 C2 expm1(-u) + lam (ln d + u) = 0.
+
+        f' = 4 C1 e^u + 4 C2 e^-u + lam > 0; f(0) = lam ln d and f(-ln d) = 4 C1 (1/d - 1) -
+        4 C2 (d - 1) have opposite signs (or one is zero), so the root lies between 0 and -ln d.
+        Newton from the root of the linearisation; a step leaving the bracket is replaced by
+        bisection."""
+        c1, c2, lam = 4.0 * self.C1, 4.0 * self.C2, self.lam
+        log_d = np.asarray(log_d, dtype=float)
+        finite = np.isfinite(log_d)
+        ld = np.where(finite, log_d, 0.0)
+        lo, hi = np.minimum(0.0, -ld), np.maximum(0.0, -ld)
+        u = -lam * ld / (c1 + c2 + lam)
+        tol = 8.0 * _EPS * (1.0 + np.abs(ld))
+        for _ in range(_NEWTON_MAX):
+            f = c1 * np.expm1(u) - c2 * np.expm1(-u) + lam * (ld + u)
+            lo = np.where(f < 0.0, u, lo)
+            hi = np.where(f > 0.0, u, hi)
+            new = u - f / (c1 * np.exp(u) + c2 * np.exp(-u) + lam)
+            new = np.where((new < lo) | (new > hi), 0.5 * (lo + hi), new)
+            du = new - u
+            u = new
+            if np.all(np.abs(du) <= tol * (1.0 + np.abs(u))):
+                return np.where(finite, u, np.nan)
+        worst = np.abs(du).max()
+        raise SolverError(
+            f"compressible Mooney-Rivlin: plane-stress condition dpsi/dC33 = 0 not converged in "
+            f"{_NEWTON_MAX} Newton steps (last step {worst:.3e} in ln C33)")
+
+    def _c33(self, p, q):
+        return np.exp(self._log_c33(np.log1p(p + q)))
+
+    def _prepare(self, p, q):
+        log_d = np.log1p(p + q)
+        return log_d, self._log_c33(log_d)
+
+    def _psi(self, p, q, aux):
+        log_d, u = aux
+        C1, C2, lam = self.C1, self.C2, self.lam
+        d = 1.0 + p + q
+        z = np.exp(u)
+        L = log_d + u                                          # 2 ln J
+        # c + z - 3 - L and c/d + 1/z - 3 + L without their O(1) parts (c = 2 + p)
+        psi = (C1 * (p + np.expm1(u) - L) + C2 * (-(p + 2.0 * q) / d + np.expm1(-u) + L)
+               + 0.125 * lam * L * L)
+        inv_d = 1.0 / d
+        pc = C1 + C2 * inv_d
+        pd = (-C1 + C2 * (q - 1.0) * inv_d + 0.25 * lam * L) * inv_d
+        m = 4.0 * (C1 * z + C2 / z) + lam                     # 4 C33^2 psi_33 > 0 at the root
+        pcd = -C2 * inv_d * inv_d
+        pdd = (C1 * z + C2 * (2.0 * (2.0 + p) * inv_d - 1.0 / z) + 0.25 * lam - 0.25 * lam * lam / m) * inv_d * inv_d
+        return psi, pc, pd, _const(0.0, d), pcd, pdd
+
+
+# ------------------------------------------------------------------------------------------------
 # registry
 # ------------------------------------------------------------------------------------------------
 #: material name -> class (``make_material`` builds them)
@@ -594,6 +724,7 @@ MATERIALS: dict[str, type] = {
     "mooney_rivlin": MooneyRivlin,
     "exponential": Exponential,
     "compressible_neo_hookean": CompressibleNeoHookean,
+    "compressible_mooney_rivlin": CompressibleMooneyRivlin,
 }
 
 #: material name -> {parameter: unit}; "Pa" entries are stresses (scale them when converting
@@ -606,12 +737,8 @@ PARAMETERS: dict[str, dict[str, str]] = {
     "mooney_rivlin": {"C1": "Pa", "C2": "Pa", "n_thickness": "count"},
     "exponential": {"C0": "Pa", "C1": "1", "n_thickness": "count"},
     "compressible_neo_hookean": {"mu": "Pa", "lam": "Pa", "E": "Pa", "nu": "1", "n_thickness": "count"},
+    "compressible_mooney_rivlin": {"C1": "Pa", "C2": "Pa", "lam": "Pa", "n_thickness": "count"},
 }
-
-
-def _hint(word: str, valid) -> str:
-    close = difflib.get_close_matches(str(word), sorted(valid), n=1)
-    return f"did you mean '{close[0]}'? " if close else ""
 
 
 def make_material(name: str, params: Mapping):
@@ -621,7 +748,8 @@ def make_material(name: str, params: Mapping):
     ----------
     name : str
         One of :data:`MATERIALS` (``linear_elastic`` = ``saint_venant_kirchhoff``,
-        ``neo_hookean``, ``mooney_rivlin``, ``exponential``, ``compressible_neo_hookean``).
+        ``neo_hookean``, ``mooney_rivlin``, ``exponential``, ``compressible_neo_hookean``,
+        ``compressible_mooney_rivlin``).
     params : mapping
         Constructor parameters, see :data:`PARAMETERS` (``n_thickness`` is optional).
 
@@ -631,15 +759,11 @@ def make_material(name: str, params: Mapping):
         Unknown name or parameter key (with a did-you-mean), missing parameter, invalid value.
     """
     if not isinstance(name, str) or name not in MATERIALS:
-        raise ProblemError(f"unknown material {name!r}: {_hint(name, MATERIALS)}"
-                           f"valid materials: {', '.join(sorted(MATERIALS))}")
+        raise ConfigError(unknown_name(name, MATERIALS, noun="material"))
     if not isinstance(params, Mapping):
         raise ProblemError(f"material {name!r}: parameters must be a table, got {type(params).__name__}")
     valid = PARAMETERS[name]
-    for key in params:
-        if key not in valid:
-            raise ProblemError(f"material {name!r}: unknown parameter {key!r}: {_hint(key, valid)}"
-                               f"valid parameters: {', '.join(valid)}")
+    check_names(params, valid, noun="parameter", prefix=f"material {name!r}: ")
     kw = dict(params)
     if name == "compressible_neo_hookean":
         has_lame, has_en = {"mu", "lam"} & kw.keys(), {"E", "nu"} & kw.keys()

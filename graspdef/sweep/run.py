@@ -47,6 +47,7 @@ from typing import Callable
 from ..errors import GraspdefError
 from ..geometry.io import atomic_folder
 from ..geometry.provenance import write_provenance
+from ..units import PRESSURE_UNITS, format_quantity
 from .spec import Case, SweepSpec
 
 log = logging.getLogger(__name__)
@@ -105,11 +106,12 @@ def run_case(case_rec: dict, cases_dir: str, attempt: int = 1) -> dict:
     threads = numba.get_num_threads()
     numba.set_num_threads(1)
     try:
+        from ..objects import OBJECT_FILE
         from ..pipeline.grasp import run_grasp
 
         t0 = time.perf_counter()
         kwargs = {"gas": {"auto": None, "on": True, "off": False}[case.gas], "control_faces": case.control_faces,
-                  "steps": case.steps, "E": None if case.E_MPa is None else case.E_MPa * 1e6}
+                  "steps": case.steps, "E": case.E_Pa}
         with atomic_folder(folder) as tmp:
             run = run_grasp(case.scene, case.force_N, case.contact, case.analysis, tmp, **kwargs)
             rec = {"case": case.record(), "status": "done", "attempts": attempt, "error": None,
@@ -119,7 +121,7 @@ def run_case(case_rec: dict, cases_dir: str, attempt: int = 1) -> dict:
             (tmp / "case.json").write_text(json.dumps(rec, indent=2) + "\n")
             write_provenance(tmp, {"case": case.record(), "run_grasp": {
                 "scene": case.scene, "force": case.force_N, "contact": case.contact, "analysis": case.analysis,
-                **kwargs}, "shell_toml": (Path(run.result["scene"]).parent / "shell.toml").read_text()},
+                **kwargs}, "object_toml": (Path(run.result["scene"]).parent / OBJECT_FILE).read_text()},
                 thread_env={k: os.environ.get(k) for k in ("MKL_NUM_THREADS", "OMP_NUM_THREADS",
                                                             "OPENBLAS_NUM_THREADS")} | {"numba": 1})
         return rec
@@ -399,7 +401,7 @@ def _row(case: Case, rec: dict | None, out: Path) -> dict:
     row = {c: "" for c in COLUMNS}
     row.update({"case_id": case.id, "scene": case.scene_name, "force_N": case.force_N, "material": case.material,
                 "analysis": case.analysis, "contact": case.contact, "control_faces": case.control_faces,
-                "E_MPa": "" if case.E_MPa is None else case.E_MPa})
+                "E_MPa": "" if case.E_Pa is None else case.E_Pa / PRESSURE_UNITS["MPa"]})
     if rec is None:
         row["status"] = "missing"
         return row
@@ -454,7 +456,7 @@ def write_summary(spec: SweepSpec, out: Path, rows: list[dict], seconds: float, 
               "n_skipped": n_skipped, "wall_seconds": seconds, "case_seconds": stats,
               "axes": {"scenes": list(spec.scenes), "forces_N": list(spec.forces_N), "materials": spec.materials,
                        "contacts": list(spec.contacts),
-                       "control_faces": list(spec.control_faces) if spec.control_faces else "shell.toml"},
+                       "control_faces": list(spec.control_faces) if spec.control_faces else "object.toml"},
               "finished_utc": _now()}
     (out / "sweep.json").write_text(json.dumps(record, indent=2) + "\n")
     with open(out / "runs.jsonl", "a") as fh:      # one line per invocation: the history of a resumed sweep
@@ -470,7 +472,8 @@ def write_summary(spec: SweepSpec, out: Path, rows: list[dict], seconds: float, 
         L += [f"Time per case (in its worker): median {stats['median']:.1f} s, min {stats['min']:.1f} s, "
               f"max {stats['max']:.1f} s, total {stats['sum']:.1f} s.", ""]
     L += ["Materials: " + "; ".join(f"`{n}` = {m['analysis']}"
-                                    + (f", E = {m['E_MPa']:g} MPa" if m["E_MPa"] is not None else ", shell.toml's E")
+                                    + (f", E = {format_quantity(m['E_Pa'], 'MPa', 'pressure')}" if m["E_Pa"] is not None
+                                       else ", the object's E")
                                     + (f", gas {m['gas']}" if m["analysis"] == "nonlinear" else "")
                                     for n, m in spec.materials.items()), ""]
     L += ["| scene | force [N] | material | contact | control faces | status | max. displacement [mm] | "

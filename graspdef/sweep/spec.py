@@ -11,109 +11,63 @@ A spec names the axes of a grid; every combination is one case, i.e. one
     forces_N = [10.63, 16.50, 20.37, 21.48]   # squeezing force per finger
     materials = ["linear", "rubber_air"]      # built-in presets or [materials.<name>] tables
     contacts = ["point"]                      # optional, default ["point"]
-    control_faces = [320, 1280]               # optional mesh levels, default: each shell.toml's
+    control_faces = [320, 1280]               # optional mesh levels, default: each object.toml's
 
     [materials.rubber_air]
     analysis = "nonlinear"                    # required: linear | nonlinear
-    E_MPa = 1.0                               # optional, default: shell.toml's
+    E = "1 MPa"                               # optional, default: object.toml's (E_MPa = 1.0: the same)
     gas = "on"                                # optional: auto | on | off (default auto)
     steps = 4                                 # optional initial load steps (nonlinear)
 
-Every key is checked (unknown keys get a did-you-mean hint), every axis must be a non-empty
-list without repeats, every scene must exist with its shell.toml and every force must lie in
-the scene's actuator range -- all before any case runs.  Errors are :class:`ProblemError`
-naming the file and the key.
+The file is read with :mod:`graspdef.config`: every key is checked (unknown keys get a
+did-you-mean hint and the accepted keys), every axis must be a non-empty list without repeats,
+every scene must exist with its object.toml, every force must lie in the scene's actuator range,
+``gas = "on"`` needs the object's [gas] and a nonlinear analysis a law that has a finite-strain
+form -- all before any case runs.  Errors are ProblemErrors naming the file, the table and the key.
 
 A case's identity is its parameters (the material's resolved options, not just its name) plus
-the SHA-256 of the scene's ``scene.xml`` and ``shell.toml``: the case folder name is a readable
+the SHA-256 of the scene's ``scene.xml`` and ``object.toml``: the case folder name is a readable
 slug and the first 10 hex digits of that hash, so an unchanged case keeps its folder (and is
 not recomputed on resume) and a changed input gives a new one.
 """
 from __future__ import annotations
 
-import difflib
 import hashlib
 import itertools
 import json
 import math
-import tomllib
 from dataclasses import asdict, dataclass
 from os import PathLike
 from pathlib import Path
 
-from ..errors import ProblemError
+from ..config import Table, parse_toml, read_toml, unknown_name
+from ..errors import ConfigError, ProblemError
 
 #: material presets available without a [materials] table
 BUILTIN_MATERIALS = {
-    "linear": {"analysis": "linear", "E_MPa": None, "gas": "auto", "steps": None},
-    "nonlinear": {"analysis": "nonlinear", "E_MPa": None, "gas": "auto", "steps": None},
+    "linear": {"analysis": "linear", "E_Pa": None, "gas": "auto", "steps": None},
+    "nonlinear": {"analysis": "nonlinear", "E_Pa": None, "gas": "auto", "steps": None},
 }
 CONTACTS = ("point", "geometric")
 GAS = ("auto", "on", "off")
 _TOP = {"sweep", "grid", "materials"}
 _SWEEP = {"name", "description"}
 _GRID = {"scenes", "forces_N", "materials", "contacts", "control_faces"}
-_GRID_REQUIRED = {"scenes", "forces_N", "materials"}
-_MATERIAL = {"analysis", "E_MPa", "gas", "steps"}
+_GRID_REQUIRED = ("scenes", "forces_N", "materials")
+#: E_MPa: the spelling before units were written as text (a number in MPa); E: a quantity
+_MATERIAL = {"analysis", "E", "E_MPa", "gas", "steps"}
 
 
-def _check_keys(table, allowed: set, ctx: str, path: str, required: set = frozenset()) -> None:
-    if not isinstance(table, dict):
-        raise ProblemError(f"{path}: [{ctx}] must be a table")
-    for k in table:
-        if k not in allowed:
-            hint = difflib.get_close_matches(k, sorted(allowed), n=1)
-            extra = f" (did you mean '{hint[0]}'?)" if hint else f" (valid: {', '.join(sorted(allowed))})"
-            raise ProblemError(f"{path}: unknown key '{k}' in [{ctx}]{extra}")
-    for k in sorted(required):
-        if k not in table:
-            raise ProblemError(f"{path}: missing key '{k}' in [{ctx}]")
-
-
-def _axis(grid: dict, key: str, path: str, kind: type, default=None) -> list:
-    if key not in grid:
-        return list(default)
-    v = grid[key]
-    if not isinstance(v, list):
-        raise ProblemError(f"{path}: [grid] {key} must be a list, got {v!r}")
-    if not v:
-        raise ProblemError(f"{path}: [grid] {key} is empty: an empty axis gives an empty sweep")
-    out = []
-    for x in v:
-        if kind is float:
-            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
-                raise ProblemError(f"{path}: [grid] {key} must hold finite numbers, got {x!r}")
-            x = float(x)
-        elif kind is int:
-            if isinstance(x, bool) or not isinstance(x, int):
-                raise ProblemError(f"{path}: [grid] {key} must hold integers, got {x!r}")
-        elif not isinstance(x, str) or not x:
-            raise ProblemError(f"{path}: [grid] {key} must hold non-empty strings, got {x!r}")
-        out.append(x)
-    dup = sorted({str(x) for x in out if out.count(x) > 1})
-    if dup:
-        raise ProblemError(f"{path}: [grid] {key} repeats {', '.join(dup)}")
-    return out
-
-
-def _material(name: str, table, path: str) -> dict:
-    ctx = f"materials.{name}"
-    _check_keys(table, _MATERIAL, ctx, path, required={"analysis"})
-    m = {"analysis": table["analysis"], "E_MPa": table.get("E_MPa"), "gas": table.get("gas", "auto"),
-         "steps": table.get("steps")}
-    if m["analysis"] not in ("linear", "nonlinear"):
-        raise ProblemError(f"{path}: [{ctx}] analysis must be 'linear' or 'nonlinear', got {m['analysis']!r}")
-    if m["E_MPa"] is not None:
-        e = m["E_MPa"]
-        if isinstance(e, bool) or not isinstance(e, (int, float)) or not math.isfinite(e) or e <= 0:
-            raise ProblemError(f"{path}: [{ctx}] E_MPa must be a positive number, got {e!r}")
-        m["E_MPa"] = float(e)
-    if m["gas"] not in GAS:
-        raise ProblemError(f"{path}: [{ctx}] gas must be one of {', '.join(GAS)}, got {m['gas']!r}")
+def _material(t: Table) -> dict:
+    t.check(_MATERIAL, ("analysis",))
+    if "E" in t and "E_MPa" in t:
+        raise t.error("give E (e.g. \"8.17 MPa\") or E_MPa, not both")
+    E = (t.quantity("E", "pressure", None, positive=True) if "E" in t
+         else t.quantity("E_MPa", "pressure", None, implied="MPa", positive=True))
+    m = {"analysis": t.string("analysis", choices=("linear", "nonlinear")), "E_Pa": E,
+         "gas": t.string("gas", "auto", choices=GAS), "steps": t.integer("steps", None, positive=True)}
     if m["analysis"] == "linear" and m["gas"] == "on":
-        raise ProblemError(f"{path}: [{ctx}] an enclosed gas needs analysis = \"nonlinear\" (p V = const is nonlinear)")
-    if m["steps"] is not None and (isinstance(m["steps"], bool) or not isinstance(m["steps"], int) or m["steps"] < 1):
-        raise ProblemError(f"{path}: [{ctx}] steps must be a positive integer, got {m['steps']!r}")
+        raise t.error("an enclosed gas needs analysis = \"nonlinear\" (p V = const is nonlinear)")
     return m
 
 
@@ -126,12 +80,12 @@ class Case:
     force_N: float
     material: str              # preset name
     analysis: str
-    E_MPa: float | None        # None: shell.toml's
+    E_Pa: float | None         # Young's modulus [Pa]; None: object.toml's
     gas: str                   # auto | on | off
     steps: int | None
     contact: str
     control_faces: int         # the control mesh's number of faces (the mesh level)
-    inputs_sha256: str         # of scene.xml + shell.toml
+    inputs_sha256: str         # of scene.xml + object.toml
 
     @property
     def key(self) -> str:
@@ -172,17 +126,16 @@ class SweepSpec:
     cases: tuple[Case, ...]
 
 
-def _scene_info(scene: str, path: str) -> tuple[str, int, str, tuple[float, float]]:
-    """(folder name, shell.toml control_faces, inputs digest, actuator force range [N])."""
-    from ..pipeline.grasp import load_shell_spec, resolve_scene
+def _scene_info(scene: str, path: str):
+    """(object data, inputs digest, actuator force range [N]) of a scene of the grid."""
+    from ..objects import load_object
 
     try:
-        xml = resolve_scene(scene)
-        shell = load_shell_spec(xml)
+        obj = load_object(scene)
     except ProblemError as exc:
         raise ProblemError(f"{path}: [grid] scenes: {exc}") from exc
-    digest = hashlib.sha256(xml.read_bytes() + b"\0" + (xml.parent / "shell.toml").read_bytes()).hexdigest()
-    return xml.parent.name, shell.control_faces, digest, _actuator_range(xml, shell.body, path)
+    digest = hashlib.sha256(obj.scene.read_bytes() + b"\0" + obj.file.read_bytes()).hexdigest()
+    return obj, digest, _actuator_range(obj.scene, obj.body, path)
 
 
 def _actuator_range(xml: Path, body: str, path: str) -> tuple[float, float]:
@@ -204,77 +157,71 @@ def _actuator_range(xml: Path, body: str, path: str) -> tuple[float, float]:
 
 def parse_spec(text: str, path: str = "<spec>") -> SweepSpec:
     """Parse and check a sweep spec given as TOML text (see the module docstring)."""
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ProblemError(f"{path}: not valid TOML: {exc}") from exc
-    _check_keys(doc, _TOP, "top level", path, required={"grid"})
-    sw = doc.get("sweep", {})
-    _check_keys(sw, _SWEEP, "sweep", path)
-    grid = doc["grid"]
-    _check_keys(grid, _GRID, "grid", path, required=_GRID_REQUIRED)
-    scenes = _axis(grid, "scenes", path, str)
-    forces = _axis(grid, "forces_N", path, float)
+    return _parse(parse_toml(text, str(path)), text)
+
+
+def _parse(doc: Table, text: str) -> SweepSpec:
+    path = doc.source
+    doc.check(_TOP, ("grid",))
+    sw = doc.table("sweep", required=False).check(_SWEEP)
+    grid = doc.table("grid").check(_GRID, _GRID_REQUIRED)
+    scenes = grid.list("scenes", "string", unique=True)
+    forces = grid.list("forces_N", "number", unique=True)
     for f in forces:
         if f <= 0:
-            raise ProblemError(f"{path}: [grid] forces_N must be positive (per finger, N), got {f:g}")
-    mats = _axis(grid, "materials", path, str)
-    contacts = _axis(grid, "contacts", path, str, default=["point"])
+            raise grid.error(f"must be positive (per finger, N), got {f:g}", "forces_N")
+    mats = grid.list("materials", "string", unique=True)
+    contacts = grid.list("contacts", "string", ["point"], unique=True)
     for c in contacts:
         if c not in CONTACTS:
-            hint = difflib.get_close_matches(c, CONTACTS, n=1)
-            raise ProblemError(f"{path}: [grid] contacts: unknown contact model {c!r}"
-                               + (f" (did you mean '{hint[0]}'?)" if hint else f" (valid: {', '.join(CONTACTS)})"))
-    faces = _axis(grid, "control_faces", path, int, default=[]) if "control_faces" in grid else None
+            raise ConfigError(f"{grid.where('contacts')}: " + unknown_name(c, CONTACTS, noun="contact model"))
+    faces = grid.list("control_faces", "integer", None, unique=True)
     for n in faces or ():
         if n < 20:
-            raise ProblemError(f"{path}: [grid] control_faces must be >= 20 (a control mesh's faces), got {n}")
-    defined = doc.get("materials", {})
-    if not isinstance(defined, dict):
-        raise ProblemError(f"{path}: [materials] must be a table of [materials.<name>] tables")
+            raise grid.error(f"must be >= 20 (a control mesh's faces), got {n}", "control_faces")
     presets = {}
-    for name, table in defined.items():
+    for name, table in doc.table("materials", required=False).children().items():
         if name in BUILTIN_MATERIALS:
-            raise ProblemError(f"{path}: [materials.{name}]: '{name}' is a built-in preset; choose another name")
-        presets[name] = _material(name, table, path)
+            raise table.error(f"'{name}' is a built-in preset; choose another name")
+        presets[name] = _material(table)
     for name in mats:
         if name not in presets and name not in BUILTIN_MATERIALS:
             valid = sorted(presets) + sorted(BUILTIN_MATERIALS)
-            hint = difflib.get_close_matches(name, valid, n=1)
-            raise ProblemError(f"{path}: [grid] materials: unknown material {name!r}"
-                               + (f" (did you mean '{hint[0]}'?)" if hint else "")
-                               + f"; define it in a [materials.{name}] table or use one of: {', '.join(valid)}")
+            raise ConfigError(f"{grid.where('materials')}: " + unknown_name(name, valid, noun="material")
+                              + f"; or define it in a [materials.{name}] table")
     unused = sorted(set(presets) - set(mats))
     if unused:
         raise ProblemError(f"{path}: [materials.{unused[0]}] is defined but not in [grid] materials")
     used = {n: presets.get(n, BUILTIN_MATERIALS.get(n)) for n in mats}
     info = {}
     for s in scenes:
-        info[s] = _scene_info(s, path)
-        lo, hi = info[s][3]
+        obj, digest, (lo, hi) = info[s] = _scene_info(s, path)
         bad = [f for f in forces if not lo <= f <= hi]
         if bad:
             raise ProblemError(f"{path}: [grid] forces_N: {bad[0]:g} N is beyond what the actuators of scene "
                                f"{s!r} can exert ({lo:g}..{hi:g} N)")
+        for n, m in used.items():
+            if m["gas"] == "on" and obj.gas is None:
+                raise ProblemError(f"{path}: [materials.{n}] gas = \"on\", but scene {s!r} has no enclosed air "
+                                   f"([gas] in {obj.file})")
+            if m["analysis"] == "nonlinear":
+                obj.shell_material("nonlinear")          # a law without a finite-strain form: an error here
     cases = []
     for s, f, m, c in itertools.product(scenes, forces, mats, contacts):
-        name, default_faces, digest, _ = info[s]
+        obj, digest, _ = info[s]
         p = used[m]
-        for n in (faces or [default_faces]):
-            cases.append(Case(s, name, f, m, p["analysis"], p["E_MPa"], p["gas"], p["steps"], c, int(n), digest))
+        for n in (faces or [obj.control_faces]):
+            cases.append(Case(s, obj.scene.parent.name, f, m, p["analysis"], p["E_Pa"], p["gas"], p["steps"], c,
+                              int(n), digest))
     ids = [c.id for c in cases]
     if len(set(ids)) != len(ids):       # two spellings of one scene, e.g. a name and its path
         raise ProblemError(f"{path}: [grid] the grid holds the same case twice (a scene given twice?)")
-    name = sw.get("name", Path(path).stem)
-    if not isinstance(name, str):
-        raise ProblemError(f"{path}: [sweep] name must be a string")
-    return SweepSpec(str(path), text, name, str(sw.get("description", "")), tuple(scenes), tuple(forces), used,
-                     tuple(contacts), tuple(faces) if faces else None, tuple(cases))
+    return SweepSpec(str(path), text, sw.string("name", Path(path).stem), sw.string("description", ""),
+                     tuple(scenes), tuple(forces), used, tuple(contacts), tuple(faces) if faces else None,
+                     tuple(cases))
 
 
 def load_spec(path: str | PathLike) -> SweepSpec:
     """Read and check a sweep spec file (``SPEC.toml``); see :func:`parse_spec`."""
-    p = Path(path)
-    if not p.is_file():
-        raise ProblemError(f"sweep spec not found: {p}")
-    return parse_spec(p.read_text(), str(p))
+    doc = read_toml(path, "sweep spec")
+    return _parse(doc, Path(path).read_text())

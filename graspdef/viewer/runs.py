@@ -25,9 +25,9 @@ import scipy.sparse as sp
 import trimesh
 
 from ..errors import GraspdefError
-from ..geometry.io import LENGTH_UNITS
 from ..solve.pathfile import FILENAME as PATH_U_FILE
 from ..solve.pathfile import read_path_u
+from ..units import LENGTH_UNITS
 
 log = logging.getLogger(__name__)
 

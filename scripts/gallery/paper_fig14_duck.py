@@ -1,6 +1,6 @@
 """Tian & Jia (2010) Fig. 14: the rubber duck under an antipodal grasp, 19.22 N per finger.
 
-Paper: t = ?.0 mm, E = ? MPa (digits illegible; scenes/duck/shell.toml assumes 1.0 mm and 1 MPa),
+Paper: t = ?.0 mm, E = ? MPa (digits illegible; scenes/duck/object.toml assumes 1.0 mm and 1 MPa),
 nu = 0.45; scanned maximum displacements 8.56 mm (back view) and 6.73 mm (front view), average
 modelling error 0.58 mm.
 
@@ -9,8 +9,10 @@ graspdef (scenes/duck: LINEMOD duck scan, CoACD rigid proxy in MuJoCo, control m
 * linear, E = 1 MPa: the indentation is ~230 mm -- meaningless for a 1 mm, 1 MPa wall: the
   paper's values as we read them are far too soft;
 * E calibrated so that the linear shell gives the paper's 8.56 mm (linear scales as 1/E), then
-  the neo-Hookean shell at that E: its path stops near 8.9 N (Newton fails past a fold where the
-  side wall under the pin dimples).  NOT reproduced; reported as computed (docs/grasp.md).
+  the neo-Hookean shell at that E (compressible, nu = 0.45): its path stops near 8.6 N (Newton
+  fails past a fold where the side wall under the pin dimples; 8.9 N with the incompressible law
+  every nonlinear run used before the object data stated its law).  NOT reproduced; reported as
+  computed (docs/grasp.md).
 
 Fast mode: the linear run only, on a coarse control mesh (600 faces).  Asserted there: invariants
 of the chain -- each finger pushes with 19.22 N along its axis, the mapped point loads keep the
@@ -35,7 +37,7 @@ FAST_FACES = 600
 
 
 def calibrated_grasp(scene: str, force: float, measured_mm: float, out: Path, fast: bool, contact: str = "point"):
-    """Linear run at shell.toml's E; in full mode also the neo-Hookean run at the E that makes the
+    """Linear run at object.toml's E; in full mode also the neo-Hookean run at the E that makes the
     linear indentation equal ``measured_mm`` (linear theory scales as 1/E).  Returns
     (linear record, nonlinear record or None, E_calibrated [Pa] or None, run folder to draw)."""
     kw = {"control_faces": FAST_FACES} if fast else {}

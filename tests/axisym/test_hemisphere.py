@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from graspdef.axisym.bench import hemisphere_path
-from graspdef.axisym.material import Material
+from graspdef.axisym.material import AxisymMaterial
 
 #: converged values measured with max_piece = 0.3, rk_steps = 2 (4x finer than the default)
 EDGE_FINE = 3.3776
@@ -51,7 +51,7 @@ def test_outward_edge_couple_turning_point_is_the_section_moment_capacity():
     rot = edge[2] - m.nodes[1].phi
     assert 1.7 < rot < 2.1 and edge[0] > 11.5  # the edge flares out (hoop stretch ~1.19) while turning
     # the edge's section is at the moment capacity: at the final state n_xi0 = 0 and dm/dc -> 0
-    mat = Material("mooney_rivlin", 1.0, 0.1)
+    mat = AxisymMaterial("mooney_rivlin", 1.0, 0.1)
     l2, c2 = edge[0] / 10.0, np.sin(edge[2]) / 10.0
     m_edge = p.points[-1].lam / 10.0
     cs = np.linspace(0.0, 2.0, 401)

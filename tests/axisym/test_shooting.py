@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from graspdef.axisym import DistributedLoad, Material, Model, Node, Segment
+from graspdef.axisym import DistributedLoad, AxisymMaterial, Model, Node, Segment
 from graspdef.axisym.equations import geometry_at, rhs
 from graspdef.axisym.shooting import end_forces, integrate, solve_bvp1, start_states, stiffness
 
@@ -16,7 +16,7 @@ def _segment_batch(load=None, rk_steps=8, a0=30.0, a1=60.0, pole=False):
     angs = np.radians([0.0 if pole else a0, a1])
     nodes = [Node(R * np.sin(a), R * np.cos(a), -a) for a in angs]
     nodes[1].fix = (False, True, False)
-    m = Model(Material("mooney_rivlin", 1.0, 0.1), 1.0, nodes, [Segment(0, 1, -1 / R, n_sub=1)],
+    m = Model(AxisymMaterial("mooney_rivlin", 1.0, 0.1), 1.0, nodes, [Segment(0, 1, -1 / R, n_sub=1)],
               distributed_loads=[load] if load else [], rk_steps=rk_steps)
     return m.build()
 

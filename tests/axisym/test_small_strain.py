@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from graspdef.axisym import Material, inflated_sphere, solve_path
+from graspdef.axisym import AxisymMaterial, inflated_sphere, solve_path
 from graspdef.axisym.bench import reissner_point_load
 
 
@@ -22,7 +22,7 @@ def test_point_load_on_sphere_matches_reissner(R_over_t, band):
 def test_balloon_pressure_maximum():
     """Inflated Mooney-Rivlin sphere, gamma = 0.1: p_max R0/(C1 t0) = 2.98124 (membrane theory,
     ../shared/BENCHMARKS.md 4.2); with R/t = 50 the shell's value is within 0.3 % (bending/thickness O(t/R))."""
-    mat = Material("mooney_rivlin", C1=1.0, gamma=0.1)
+    mat = AxisymMaterial("mooney_rivlin", C1=1.0, gamma=0.1)
     t = 0.02
     m = inflated_sphere(1.0, t, mat, p=t, max_piece=0.4)
     p = solve_path(m, ds=10.0, ds_max=100.0, max_steps=60, unload_fraction=0.999, on_failure="stop")
@@ -32,7 +32,7 @@ def test_balloon_pressure_maximum():
 def test_balloon_follows_membrane_curve():
     """Before the maximum the pressure-stretch curve is the membrane one, p R0/(C1 t0) = 4 (1/l - 1/l^7)(1 + g l^2)
     (BENCHMARKS.md 4.2), to 0.1 % at R/t = 50."""
-    mat = Material("mooney_rivlin", C1=1.0, gamma=0.1)
+    mat = AxisymMaterial("mooney_rivlin", C1=1.0, gamma=0.1)
     t = 0.02
     m = inflated_sphere(1.0, t, mat, p=t)
     p = solve_path(m, ds=10.0, ds_max=100.0, max_steps=4)
@@ -45,7 +45,7 @@ def test_exponential_balloon_follows_membrane_curve():
     """Exponential law w = (exp(g (I1 - 3)) - 1)/g: membrane balloon p R0/(C1 t0) = 4 (1/l - 1/l^7)
     exp(g (2 l^2 + l^-4 - 3)) (derived as in BENCHMARKS.md 4.2 from dW/dl), to 0.1 % at R/t = 50."""
     g = 0.5
-    mat = Material("exponential", C1=1.0, gamma=g)
+    mat = AxisymMaterial("exponential", C1=1.0, gamma=g)
     t = 0.02
     m = inflated_sphere(1.0, t, mat, p=t)
     p = solve_path(m, ds=10.0, ds_max=100.0, max_steps=3)

@@ -44,7 +44,7 @@ def test_bad_input_leaves_nothing(tmp_path, capsys):
     with pytest.raises(GraspdefError, match="contact must be"):
         run_grasp("tennis_ball", 5.0, "pressure", "linear", out)
     assert not out.exists() and not list(tmp_path.glob(".bad*"))
-    with pytest.raises(GraspdefError, match="no shell.toml"):
+    with pytest.raises(GraspdefError, match="no object.toml beside the scene"):
         run_grasp("test_sphere", 5.0, "point", "linear", None)
 
 
@@ -52,11 +52,12 @@ def test_open_scan_is_refused(monkeypatch, tmp_path):
     """A scan that is not watertight cannot give a closed shell: MeshError before any output."""
     from graspdef.errors import MeshError
     from graspdef.geometry import TriMesh, icosphere
+    from graspdef.objects import build
     from graspdef.pipeline import grasp as gp
 
     ball = icosphere(radius=0.03, subdivisions=3)
     keep = ball.vertices[ball.faces].mean(axis=1)[:, 2] > -0.01        # cut the bottom off
-    monkeypatch.setattr(gp, "load_scan", lambda scan_id: TriMesh(ball.vertices, ball.faces[keep]))
+    monkeypatch.setattr(build, "load_scan", lambda scan_id: TriMesh(ball.vertices, ball.faces[keep]))
     out = tmp_path / "run"
     with pytest.raises(MeshError, match="not closed"):
         gp.run_grasp("tennis_ball", 10.0, "point", "linear", out)

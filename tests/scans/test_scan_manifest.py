@@ -74,10 +74,26 @@ def test_unknown_id_and_bad_manifests(tmp_path, manifest):
     bad = tmp_path / "m.toml"
     bad.write_text('[real.x]\npath = "x.ply"\nunits = "furlong"\nframe = "f"\nlicence = "l"\n'
                    'source = "s"\n')
-    with pytest.raises(ProblemError, match="unknown units 'furlong'"):
+    with pytest.raises(ProblemError, match=r"m.toml: \[real.x\] units: unknown length unit 'furlong'; "
+                                           r"accepted: m, mm, cm, um, in"):
         _load(bad)
     bad.write_text('[real.x]\npath = "x.ply"\nunits = "m"\n')
-    with pytest.raises(ProblemError, match="real.x lacks frame, licence, source"):
+    with pytest.raises(ProblemError, match=r"missing keys 'frame', 'licence', 'source' in \[real.x\]"):
+        _load(bad)
+
+
+@pytest.mark.parametrize("text, message", [
+    ('[real.x]\npath = "x.ply"\nunits = "m"\nframe = "f"\nlicence = "l"\nsource = "s"\nblobb = "0"\n',
+     r"unknown key 'blobb' in \[real.x\] \(did you mean 'blob'\?\); accepted: blob, "),
+    ('[real.x]\ndefaults = "ycbb"\npath = "x.ply"\n[defaults.ycb]\nunits = "m"\n',
+     r"\[real.x\] unknown defaults 'ycbb' \(did you mean 'ycb'\?\)"),
+    ('[generated.g]\nsource = "x"\nsigma = 0.1\n', r"unknown key 'sigma' in \[generated.g\] \(did you mean 'sigma_mm'\?\)"),
+    ('[real.x]\npath = "x.ply\n', r"m.toml: line 2, column \d+: not valid TOML"),
+])
+def test_manifest_errors_name_the_table_and_key(tmp_path, text, message):
+    bad = tmp_path / "m.toml"
+    bad.write_text(text)
+    with pytest.raises(ProblemError, match=message):
         _load(bad)
 
 

@@ -13,6 +13,7 @@ from graspdef.shell.energy import ShellEnergy
 from graspdef.shell.hyperelastic import (
     MATERIALS,
     PARAMETERS,
+    CompressibleMooneyRivlin,
     CompressibleNeoHookean,
     Exponential,
     MooneyRivlin,
@@ -36,6 +37,9 @@ ALL = {
     "exponential": Exponential(C0=0.625, C1=0.8),
     "compressible_neo_hookean": CompressibleNeoHookean(mu=1.0, lam=1.5),
     "compressible_neo_hookean_nu0": CompressibleNeoHookean(mu=1.0, lam=0.0, n_thickness=4),
+    "compressible_mooney_rivlin": CompressibleMooneyRivlin(C1=0.35, C2=0.15, lam=1.5),
+    "compressible_mooney_rivlin_nu0": CompressibleMooneyRivlin(C1=0.2, C2=0.3, lam=0.0, n_thickness=4),
+    "compressible_mooney_rivlin_c2_only": CompressibleMooneyRivlin(C1=0.0, C2=0.5, lam=20.0),
 }
 HYPER = {k: v for k, v in ALL.items() if k != "linear_elastic"}
 INCOMPRESSIBLE = {k: v for k, v in HYPER.items() if not k.startswith("compressible")}
@@ -179,6 +183,12 @@ SMALL_STRAIN = [
     (CompressibleNeoHookean.from_E_nu(5e6, 0.49), LinearElastic(E=5e6, nu=0.49)),
     # mu = E / (2 (1 + nu)) = 1, lam = E nu / ((1 + nu)(1 - 2 nu)) = 1.5 <=> E = 2.6, nu = 0.3
     (CompressibleNeoHookean(mu=1.0, lam=1.5), LinearElastic(E=2.6, nu=0.3)),
+    (CompressibleMooneyRivlin.from_E_nu(1e6, 0.3, 0.25), LinearElastic(E=1e6, nu=0.3)),
+    (CompressibleMooneyRivlin.from_E_nu(1e6, 0.45, 0.1), LinearElastic(E=1e6, nu=0.45)),
+    (CompressibleMooneyRivlin.from_E_nu(2e11, 0.0, 1.0, n_thickness=2), LinearElastic(E=2e11, nu=0.0)),
+    (CompressibleMooneyRivlin.from_E_nu(5e6, 0.49, 0.0), LinearElastic(E=5e6, nu=0.49)),
+    # mu = 2 (C1 + C2) = 1, lam = 1.5 <=> E = 2.6, nu = 0.3 (whatever C2/C1)
+    (CompressibleMooneyRivlin(C1=0.35, C2=0.15, lam=1.5), LinearElastic(E=2.6, nu=0.3)),
 ]
 
 
@@ -335,6 +345,59 @@ def test_compressible_neo_hookean_is_the_plane_stress_3d_law(mu, lam):
                                    atol=1e-14 * (mu + lam) * t0)
 
 
+@pytest.mark.parametrize("C1, C2, lam", [(0.35, 0.15, 1.5), (0.5, 0.0, 1.5), (0.0, 0.5, 0.0), (0.1, 0.4, 49.0),
+                                         (3e5, 1e5, 2e7)])
+def test_compressible_mooney_rivlin_is_the_plane_stress_3d_law(C1, C2, lam):
+    """Compressible Mooney-Rivlin, psi = C1 (I1 - 3 - 2 ln J) + C2 (tr C^-1 - 3 + 2 ln J) + lam/2 (ln J)^2, so
+    S = 2 C1 (G^-1 - C^-1) + 2 C2 (C^-1 - C^-1 G C^-1) + lam ln J C^-1; homogeneous membrane states with in-plane
+    stretches up to ~1.5: the solved C33 = thickness_stretch^2 makes S^33 = 2 C1 (1 - 1/C33) + 2 C2 (1/C33 -
+    1/C33^2) + lam ln J / C33 vanish (plane stress, to round-off), and dW/de equals t0 S^ab (in-plane block of the
+    3D stress, J^2 = C33 det C_ab / det A_ab).  C2 = 0 is the compressible neo-Hookean law with mu = 2 C1."""
+    rng = np.random.default_rng(5)
+    t0 = 0.05
+    mat = CompressibleMooneyRivlin(C1, C2, lam)
+    s, ri = _membrane_states(rng, 20)
+    _, dW, _ = mat.density(s, ri, t0)
+    c33 = mat.thickness_stretch(s, ri) ** 2
+    scale = C1 + C2 + lam
+    for si, r, g, C33 in zip(s, ri, dW, c33):
+        Ainv = np.array([[r[0], r[2]], [r[2], r[1]]])
+        A = np.linalg.inv(Ainv)
+        C = A + 2 * np.array([[si[0], si[2] / 2], [si[2] / 2, si[1]]])
+        Ci = np.linalg.inv(C)
+        lnJ = 0.5 * math.log(C33 * np.linalg.det(C) / np.linalg.det(A))
+        S33 = 2 * C1 * (1 - 1 / C33) + 2 * C2 * (1 / C33 - 1 / C33 ** 2) + lam * lnJ / C33
+        assert abs(S33) <= 1e-14 * scale
+        S = 2 * C1 * (Ainv - Ci) + 2 * C2 * (Ci - Ci @ A @ Ci) + lam * lnJ * Ci
+        np.testing.assert_allclose(g[:3], t0 * np.array([S[0, 0], S[1, 1], S[0, 1]]), rtol=1e-11,
+                                   atol=1e-14 * scale * t0)
+    if C2 == 0.0:
+        ref = CompressibleNeoHookean(2 * C1, lam).density(s, ri, t0)
+        for a, b in zip(mat.density(s, ri, t0), ref):
+            np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-14 * np.abs(b).max())
+
+
+def test_compressible_mooney_rivlin_extreme_stretches():
+    """The safeguarded plane-stress Newton solve converges from d = 1e-6 to 1e6 (equibiaxial), also for C1 = 0 and
+    for nearly incompressible lam/mu = 1e6 (C33 -> 1/d); at lam = 0 the root is C33 = 1 (f(0) = lam ln d)."""
+    d = np.logspace(-6, 6, 25)
+    e = (np.sqrt(d) - 1) / 2
+    s = np.stack([e, e] + [np.zeros_like(d)] * 4, -1)
+    ri = np.array([1.0, 1.0, 0.0])
+    for C1, C2, lam in ((0.4, 0.1, 0.0), (0.4, 0.1, 1.0), (0.0, 0.5, 3.0), (0.4, 0.1, 1e6)):
+        mat = CompressibleMooneyRivlin(C1, C2, lam)
+        C33 = mat.thickness_stretch(s, ri) ** 2
+        p, q, *_ = in_plane_invariants(s[:, :3], ri)
+        ln_c33, ln_d = np.log(C33), np.log1p(p + q)
+        r = 4 * C1 * (C33 - 1) + 4 * C2 * (1 - 1 / C33) + lam * (ln_c33 + ln_d)
+        assert np.all(np.abs(r) <= 1e-14 * (4 * C1 * C33 + 4 * C2 / C33 + lam * (1 + np.abs(ln_c33) + np.abs(ln_d)))), r
+        if lam == 0.0:
+            np.testing.assert_array_equal(C33, 1.0)
+        if lam == 1e6:
+            mid = (d >= 1e-2) & (d <= 1e2)
+            np.testing.assert_allclose(C33[mid], 1 / d[mid], rtol=2.5e-4)
+
+
 def test_compressible_neo_hookean_extreme_stretches():
     """The plane-stress Newton solve converges (C33 S^33 = 0 to round-off) from strong compression
     (d = 1e-6) to strong stretch (d = 1e6) and for nearly incompressible lam/mu = 1e6, where the
@@ -374,7 +437,8 @@ def test_inverted_material_has_infinite_energy(name):
 # ------------------------------------------------------------------------------------------------
 # in a shell
 # ------------------------------------------------------------------------------------------------
-@pytest.mark.parametrize("name", ["neo_hookean", "compressible_neo_hookean", "mooney_rivlin_c2_only"])
+@pytest.mark.parametrize("name", ["neo_hookean", "compressible_neo_hookean", "mooney_rivlin_c2_only",
+                                  "compressible_mooney_rivlin"])
 def test_in_shell_energy(name):
     """ShellEnergy on a ghosted 6 x 4 rectangle with a hyperelastic material: zero energy and
     gradient at rest and after a rigid rotation (objectivity); gradient and Hessian-vector
@@ -429,6 +493,13 @@ def test_in_shell_energy(name):
     (lambda: CompressibleNeoHookean.from_E_nu(1.0, -0.1), r"nu must lie in \[0, 0.5\)"),
     (lambda: CompressibleNeoHookean.from_E_nu(-1.0, 0.3), "E must be positive"),
     (lambda: CompressibleNeoHookean.from_E_nu(1.0, NAN), "nu must be finite"),
+    (lambda: CompressibleMooneyRivlin(-1.0, 1.0, 1.0), "C1 must be >= 0"),
+    (lambda: CompressibleMooneyRivlin(0.0, 0.0, 1.0), r"C1 \+ C2 > 0"),
+    (lambda: CompressibleMooneyRivlin(1.0, 1.0, -0.1), "lam .* must be >= 0"),
+    (lambda: CompressibleMooneyRivlin(1.0, NAN, 1.0), "C2 must be finite"),
+    (lambda: CompressibleMooneyRivlin.from_E_nu(1.0, 0.5, 0.1), r"nu must lie in \[0, 0.5\).*use mooney_rivlin"),
+    (lambda: CompressibleMooneyRivlin.from_E_nu(1.0, 0.3, -0.1), "C2/C1 must be >= 0"),
+    (lambda: CompressibleMooneyRivlin.from_E_nu(0.0, 0.3, 0.1), "E must be positive"),
 ])
 def test_invalid_parameters_are_rejected(make, match):
     """Non-positive or non-finite moduli, negative Mooney-Rivlin constants or C1 + C2 = 0,
@@ -451,16 +522,19 @@ def test_registry_builds_every_material():
     assert make_material("compressible_neo_hookean", {"mu": 1.0, "lam": 2.0}) == CompressibleNeoHookean(1.0, 2.0)
     assert (make_material("compressible_neo_hookean", {"E": 2.6, "nu": 0.3})
             == CompressibleNeoHookean.from_E_nu(2.6, 0.3))
+    assert (make_material("compressible_mooney_rivlin", {"C1": 1.0, "C2": 2.0, "lam": 3.0})
+            == CompressibleMooneyRivlin(1.0, 2.0, 3.0))
     assert set(MATERIALS) == set(PARAMETERS)
 
 
 @pytest.mark.parametrize("name, params, match", [
-    ("neo_hokean", {"mu": 1.0}, "unknown material 'neo_hokean': did you mean 'neo_hookean'"),
-    ("rubber", {"mu": 1.0}, "valid materials: compressible_neo_hookean, exponential, linear_elastic"),
-    ("neo_hookean", {"mue": 1.0}, "unknown parameter 'mue': did you mean 'mu'"),
+    ("neo_hokean", {"mu": 1.0}, r"unknown material 'neo_hokean' \(did you mean 'neo_hookean'\?\)"),
+    ("rubber", {"mu": 1.0}, "accepted: compressible_mooney_rivlin, compressible_neo_hookean, exponential, linear_elastic"),
+    ("neo_hookean", {"mue": 1.0}, r"unknown parameter 'mue' \(did you mean 'mu'\?\)"),
     ("neo_hookean", {}, "missing parameter.* mu"),
     ("mooney_rivlin", {"C1": 1.0}, "missing parameter.* C2"),
-    ("mooney_rivlin", {"C1": 1.0, "C3": 1.0}, "unknown parameter 'C3'.*valid parameters: C1, C2, n_thickness"),
+    ("mooney_rivlin", {"C1": 1.0, "C3": 1.0}, "unknown parameter 'C3'.*accepted: C1, C2, n_thickness"),
+    ("compressible_mooney_rivlin", {"C1": 1.0, "C2": 1.0}, "missing parameter.* lam"),
     ("linear_elastic", {"E": 1.0}, "missing parameter.* nu"),
     ("compressible_neo_hookean", {"mu": 1.0, "nu": 0.3}, "either .mu, lam. or .E, nu., not both"),
     ("compressible_neo_hookean", {"E": 1.0}, "missing parameter.* nu"),

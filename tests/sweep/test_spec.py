@@ -30,7 +30,7 @@ def test_grid_is_the_product_of_the_axes():
     spec = parse_spec(GOOD, "good.toml")
     assert len(spec.cases) == 1 * 2 * 2 * 1 * 2
     soft = [c for c in spec.cases if c.material == "soft"][0]
-    assert (soft.analysis, soft.E_MPa, soft.gas) == ("nonlinear", 2.0, "off")
+    assert (soft.analysis, soft.E_Pa, soft.gas) == ("nonlinear", 2e6, "off")
     assert len({c.id for c in spec.cases}) == 8
     assert spec.cases[0].id.startswith("tennis_ball_5N_linear_point_320f_")
 
@@ -43,19 +43,22 @@ def test_case_identity_is_stable_and_covers_the_options():
     assert {c.id for c in changed if c.material == "linear"} == {c.id for c in a if c.material == "linear"}
     assert not {c.id for c in changed if c.material == "soft"} & {c.id for c in a if c.material == "soft"}
     c = a[0]
-    assert dataclasses.replace(c, inputs_sha256="0" * 64).id != c.id   # an edited shell.toml is a new case
+    assert dataclasses.replace(c, inputs_sha256="0" * 64).id != c.id   # an edited object.toml is a new case
+    text = parse_spec(GOOD.replace("E_MPa = 2.0", 'E = "2 MPa"'), "d.toml").cases
+    assert [c.id for c in text] == [c.id for c in a]                # E as a quantity: the same cases
 
 
 def test_default_axes():
     spec = parse_spec('[grid]\nscenes = ["tennis_ball"]\nforces_N = [5]\nmaterials = ["linear"]\n', "d.toml")
     (c,) = spec.cases
-    assert (c.contact, c.control_faces, c.E_MPa, c.gas) == ("point", 1280, None, "auto")
+    assert (c.contact, c.control_faces, c.E_Pa, c.gas) == ("point", 1280, None, "auto")
     assert spec.name == "d"
 
 
 @pytest.mark.parametrize("edit, message", [
     (("forces_N = [5.0, 10.0]", "force_N = [5.0, 10.0]"), "unknown key 'force_N' in [grid] (did you mean 'forces_N'?)"),
-    (("[sweep]", "[sweeps]"), "unknown key 'sweeps' in [top level] (did you mean 'sweep'?)"),
+    (("[sweep]", "[sweeps]"), "unknown key 'sweeps' in [top level] (did you mean 'sweep'?); accepted: grid, "
+                              "materials, sweep"),
     (("gas = \"off\"", "gass = \"off\""), "unknown key 'gass' in [materials.soft] (did you mean 'gas'?)"),
     (("forces_N = [5.0, 10.0]", "forces_N = []"), "[grid] forces_N is empty"),
     (("scenes = [\"tennis_ball\"]", "scenes = []"), "[grid] scenes is empty"),
@@ -68,16 +71,29 @@ def test_default_axes():
     (("forces_N = [5.0, 10.0]", "forces_N = [5.0, 45.0]"), "45 N is beyond what the actuators"),
     (("forces_N = [5.0, 10.0]", "forces_N = [5.0, 5.0]"), "[grid] forces_N repeats 5"),
     (("forces_N = [5.0, 10.0]", "forces_N = [-5.0]"), "forces_N must be positive"),
-    (("analysis = \"nonlinear\"", "analysis = \"nonlinar\""), "analysis must be 'linear' or 'nonlinear'"),
-    (("E_MPa = 2.0", "E_MPa = -2.0"), "E_MPa must be a positive number"),
+    (("analysis = \"nonlinear\"", "analysis = \"nonlinar\""),
+     "[materials.soft] unknown analysis 'nonlinar' (did you mean 'nonlinear'?); accepted: linear, nonlinear"),
+    (("E_MPa = 2.0", "E_MPa = -2.0"), "[materials.soft] E_MPa must be positive, got -2.0"),
+    (("E_MPa = 2.0", 'E = "2 mm"'), "[materials.soft] E '2 mm' is a length; expected a pressure"),
+    (("E_MPa = 2.0", 'E = "2 MPa"\nE_MPa = 2.0'), "[materials.soft] give E"),
+    (("E_MPa = 2.0", "E_MPa = nan"), "[materials.soft] E_MPa must be finite"),
     (("control_faces = [320, 1280]", "control_faces = [10]"), "control_faces must be >= 20"),
     (("control_faces = [320, 1280]", "control_faces = [320.5]"), "control_faces must hold integers"),
-    (("[sweep]", "[sweep"), "not valid TOML"),
+    (("[sweep]", "[sweep"), "line 2, column 7: not valid TOML"),
 ])
 def test_bad_spec_is_one_clear_error(edit, message):
     with pytest.raises(ProblemError) as exc:
         parse_spec(GOOD.replace(*edit), "bad.toml")
     assert message in str(exc.value) and str(exc.value).startswith("bad.toml: ")
+
+
+def test_gas_on_needs_the_objects_air():
+    """gas = "on" for an object whose data has no [gas] is refused before any case runs (no built-in pressure)."""
+    duck = GOOD.replace('scenes = ["tennis_ball"]', 'scenes = ["duck"]').replace('gas = "off"', 'gas = "on"')
+    with pytest.raises(ProblemError, match=r"bad.toml: \[materials.soft\] gas = \"on\", but scene 'duck' has no "
+                                           r"enclosed air \(\[gas\] in .*scenes/duck/object.toml\)"):
+        parse_spec(duck, "bad.toml")
+    assert parse_spec(duck.replace('gas = "on"', 'gas = "off"'), "ok.toml").cases
 
 
 def test_material_table_not_in_grid_and_builtin_shadowing():

@@ -1,0 +1,93 @@
+"""Problem files through graspdef.config: the same SI values as before, values with their own units
+where the file has physical units, and errors naming file, table and key."""
+import pytest
+
+from graspdef.errors import ProblemError
+from graspdef.problem.config import load_problem
+
+BASE = """
+name = "small_plate"
+[units]
+length = "mm"
+force = "N"
+[geometry]
+type = "rectangle"
+lx = 100.0
+ly = 100.0
+nx = 4
+ny = 4
+[material]
+E = 1000.0
+nu = 0.3
+[shell]
+thickness = 1.0
+[regions]
+edges = "abs(abs(x) - 50) < 1e-6 or abs(abs(y) - 50) < 1e-6"
+[[supports]]
+kind = "simply_supported"
+region = "edges"
+[[loads]]
+kind = "pressure"
+p = 0.01
+[[probes]]
+name = "centre"
+at = [0.0, 0.0, 0.0]
+"""
+
+
+def _load(tmp_path, text):
+    f = tmp_path / "p.toml"
+    f.write_text(text)
+    return load_problem(f)
+
+
+def test_file_units_to_si(tmp_path):
+    """N and mm: E = 1000 N/mm^2 = 1 GPa, t = 1 mm, p = 0.01 N/mm^2 = 10 kPa, 100 mm wide."""
+    spec = _load(tmp_path, BASE)
+    sh = spec.problem.shell
+    assert (sh.material.E, sh.material.nu) == (1000.0 * (1.0 / 1e-3 ** 2), 0.3)
+    assert (spec.length_scale, spec.force_scale) == (1e-3, 1.0)
+    assert sh.mesh.vertices[: sh.mesh.n_real, 0].max() == pytest.approx(0.05, rel=1e-15)
+    assert spec.problem.loads[0].p == 0.01 * 1.0 / 1e-3 ** 2
+
+
+def test_values_with_their_own_units_are_the_same(tmp_path):
+    """thickness = "1 mm", E = "1 GPa", p = "10 kPa", lx = "10 cm": the same shell and load as the
+    plain numbers in the file's units (to round-off of the two conversions)."""
+    a = _load(tmp_path, BASE).problem
+    b = _load(tmp_path, BASE.replace("thickness = 1.0", 'thickness = "1 mm"').replace("E = 1000.0", 'E = "1 GPa"')
+              .replace("p = 0.01", 'p = "10 kPa"').replace("lx = 100.0", 'lx = "10 cm"')).problem
+    assert b.shell.material.E == pytest.approx(a.shell.material.E, rel=1e-15)
+    assert b.loads[0].p == pytest.approx(a.loads[0].p, rel=1e-15)
+    assert float(b.shell.thickness) == float(a.shell.thickness) == 1e-3
+    assert abs(b.shell.mesh.vertices - a.shell.mesh.vertices).max() <= 1e-17
+
+
+@pytest.mark.parametrize("edit, message", [
+    (('thickness = 1.0', 'thickness = "1 MPa"'), r"p.toml: \[shell\] thickness '1 MPa' is a pressure; expected a length"),
+    (('length = "mm"\nforce = "N"', 'length = "consistent"\nforce = "consistent"'), None),
+    (('E = 1000.0', 'E = 1000.0\nEE = 1.0'),
+     r"p.toml: unknown key 'EE' in \[material\] \(did you mean 'E'\?\); accepted: E, model, nu"),
+    (('[[probes]]', '[[probes]]\nnmae = "x"'), r"unknown key 'nmae' in \[probes 1\] \(did you mean 'name'\?\)"),
+    (('kind = "pressure"', 'kind = "presure"'), r"\[loads 1\] unknown kind 'presure' \(did you mean 'pressure'\?\)"),
+    (('p = 0.01', 'p = "0.01"'), None),
+    (('name = "centre"', 'name = 3'), r"\[probes 1\] name must be a non-empty string, got 3"),
+    (('[[loads]]', '[solver]\ntype = "linear"\nsteps = 3\n[[loads]]'),
+     r"p.toml: \[solver\] steps only apply to type = \"nonlinear\""),
+    (('[[loads]]', '[solver]\ntype = "nonlin"\n[[loads]]'), r"\[solver\] unknown type 'nonlin' \(did you mean 'nonlinear'\?\)"),
+    (('nx = 4', 'nx = 4.0'), r"\[geometry\] nx must be an integer, got 4.0"),
+    (('[units]', '[units'), r"p.toml: line \d+, column \d+: not valid TOML"),
+])
+def test_errors_name_file_table_and_key(tmp_path, edit, message):
+    text = BASE.replace(*edit)
+    if message is None:                 # a consistent file takes plain numbers: the text value is refused
+        text = text.replace("thickness = 1.0", 'thickness = "1 mm"') if "consistent" in text else text
+        if "consistent" in text:
+            message = (r"p.toml: \[shell\] thickness has a unit \('1 mm'\) but the file's units are 'consistent': give "
+                       r"a plain number")
+        else:                           # a number in a string: the file's unit is implied
+            assert _load(tmp_path, text).problem.loads[0].p == 0.01 / 1e-3 ** 2
+            return
+    with pytest.raises(ProblemError, match=message) as exc:
+        _load(tmp_path, text)
+    assert "\n" not in str(exc.value)
