@@ -68,13 +68,13 @@ def main() -> None:
             r = run_grasp(scene, f, contact, analysis, out / f"{key}_{f:g}N", gas=gas, E=E).result
             fb = r["feedback"]
             row[key] = {"indentation_mm": fb["indentation_per_finger_m"] * 1e3,
-                        "max_displacement_mm": r["max_displacement_m"] * 1e3,
+                        "max_displacement_mm": r["derived"]["max_displacement"]["value"] * 1e3,
                         "completed": r["convergence"]["completed"],
                         "load_factor": r["convergence"].get("load_factor", 1.0),
                         "E_Pa": r["material"]["E_Pa"], "time_s": r["timings_s"]["total"],
                         "per_finger_N": {s: v.get("contact_force_along_axis_N") or v["normal_force_N"]
                                          for s, v in r["fingers"].items()},
-                        "contact_area_mm2": r["contact_area_m2"] * 1e6 / 2 if contact == "geometric" else None,
+                        "contact_area_mm2": r["derived"]["contact_area"]["value"] * 1e6 / 2 if contact == "geometric" else None,
                         "iterations": r["convergence"].get("newton_iterations"),
                         "residual_N": r["residual"]["net_force_N"]}
             print(f, key, json.dumps(row[key]), flush=True)

@@ -257,14 +257,16 @@ def run(subdivisions=(3, 4), forces=FORCES_N, n_points: int = 30_000, seed: int 
 
 
 def write_runs(root: Path, pred: dict, scans, forces, merid) -> Path:
-    """Each prediction as a run folder (result.json, deformed.ply, undeformed.ply [m]; path.csv
-    for the nonlinear ones), scored with ``graspdef score`` against the scan of its force
+    """Each prediction as a run folder (graspdef.runs.write_run: result.json, deformed.ply,
+    undeformed.ply [m]; path.csv for the nonlinear ones), scored with ``graspdef score`` against the scan of its force
     (``<run>/score``), and ``graspdef report --table`` over them (``report_<n>.html``): the study
     in the layout of Table I, the reference's apex displacement as the "measured" value."""
     import csv as _csv
 
-    from graspdef.geometry.io import atomic_folder, save_ply
     from graspdef.registration import score_cli
+    from graspdef.runs import derived
+    from graspdef.runs.record import SI_UNITS, RunRecord
+    from graspdef.runs.write import write_run
     from graspdef.report import build_report
     from graspdef.scans import write_scan
 
@@ -280,26 +282,21 @@ def write_runs(root: Path, pred: dict, scans, forces, merid) -> Path:
             d = root / f"{kind}_{n}_{F:.2f}N"
             u = surf.vertices - und.vertices
             apex = -pred[f"apex_{kind}_m"][i]
-            rec = {"name": d.name, "units": {"length": "m", "force": "N"}, "analysis": kind,
-                   "description": f"3-D shell ({n} control vertices), sphere pinched by rings of {F} N "
-                                  "(scripts/synthetic_scan_study.py)",
-                   "max_displacement": float(np.linalg.norm(u, axis=1).max()),
-                   "probes": {"apex": {"displacement": [0.0, 0.0, -apex]}},
-                   "files": {"deformed": "deformed.ply"}}
             f = pred["factors"][i]
             pts = [p for p in pred["path"] if p[0] <= f * (1 + 1e-9)]
+            data = {"description": f"3-D shell ({n} control vertices), sphere pinched by rings of {F} N "
+                                   "(scripts/synthetic_scan_study.py)",
+                    "probes": {"apex": {"displacement": [0.0, 0.0, -apex]}}}
+            path = None
             if kind == "nonlinear":
-                rec.update(completed=True, load_factor=f, newton_iterations=[p[1] for p in pts[1:]])
-            with atomic_folder(d) as tmp:
-                (tmp / "result.json").write_text(json.dumps(rec, indent=2) + "\n")
-                save_ply(tmp / "deformed.ply", surf.vertices, surf.faces, units="m")
-                save_ply(tmp / "undeformed.ply", und.vertices, und.faces, units="m")
-                if kind == "nonlinear":
-                    with (tmp / "path.csv").open("w", newline="") as fh:
-                        w = _csv.writer(fh)
-                        w.writerow(["point", "load_factor", "newton_iterations", "top_ux[m]", "top_uy[m]", "top_uz[m]"])
-                        for k, (lf, its, top) in enumerate(pts):
-                            w.writerow([k, lf, its, *top])
+                data["convergence"] = {"completed": True, "load_factor": f,
+                                       "newton_iterations": [p[1] for p in pts[1:]]}
+                path = (["point", "load_factor", "newton_iterations", "top_ux[m]", "top_uy[m]", "top_uz[m]"],
+                        [[k, lf, its, *top] for k, (lf, its, top) in enumerate(pts)])
+            md = derived.max_displacement(und.vertices, u, "m", rigid_motion_removed=False, reference="rest shape")
+            rec = RunRecord("synthetic", d.name, kind, dict(SI_UNITS), {"max_displacement": md}, {}, data)
+            write_run(d, rec, rest=und.vertices, deformed=surf.vertices, faces=surf.faces, displacement=u,
+                      path=path, provenance={"script": "scripts/synthetic_scan_study.py", "force_N": F})
             score_cli(d / "deformed.ply", scan_path, d / "score")
             table.append((d.name, F, -merid[i]["apex_m"] * MM))
     csv_path = root / f"table_{n}.csv"

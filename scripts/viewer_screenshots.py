@@ -52,7 +52,6 @@ at = [0.0, 0.0, 32.5]
 def solve(out: Path, kind: str) -> Path:
     from graspdef.problem.config import load_problem
     from graspdef.solve.output import write_run
-    from graspdef.viewer import write_solution_path
 
     text = BALL.format(kind=kind, model="linear_elastic" if kind == "linear" else "saint_venant_kirchhoff",
                        solver="" if kind == "linear" else '[solver]\ntype = "nonlinear"\nsteps = 5')
@@ -66,9 +65,7 @@ def solve(out: Path, kind: str) -> Path:
     else:
         from graspdef.solve.nonlinear import path_options, solve_nonlinear
         sol = solve_nonlinear(spec.problem, path_options(spec.solver), allow_partial=True)
-    d = write_run(out / f"ball_{kind}", spec, sol, text)
-    if kind != "linear":
-        write_solution_path(d, sol)
+    d = write_run(out / f"ball_{kind}", spec, sol, text)          # nonlinear: path_u.npz included
     top = sol.probe("top")[2] * 1e3
     contacts = {"units": {"length": "mm", "force": "N"},
                 "fingers": [{"name": "top_pad", "position": [0, 0, 32.5 + top + 4], "size": [14, 14, 8]},
@@ -82,7 +79,7 @@ def solve(out: Path, kind: str) -> Path:
 def synthetic_score(run: Path) -> None:
     """A 'scan' = the predicted surface plus a 0.4 mm bump on one side (errors known)."""
     from graspdef.geometry.io import save_ply
-    from graspdef.viewer.runs import read_run
+    from graspdef.runs.read import read_run
 
     r = read_run(run)
     x = r.deformed_vertices

@@ -11,8 +11,8 @@ import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "graspdef"
 #: lowest first; a module may import graspdef modules of its own layer or of a lower one
-LAYERS = ["errors", "units", "runtime", "config", "testing", "geometry", "subdivision", "shell", "axisym", "problem",
-          "solve", "contact", "sim", "scans", "registration", "objects", "runs", "viewer", "report", "pipeline",
+LAYERS = ["errors", "units", "runtime", "config", "testing", "geometry", "runs", "subdivision", "shell", "axisym",
+          "problem", "solve", "contact", "sim", "scans", "registration", "objects", "viewer", "report", "pipeline",
           "sweep", "bench", "cli"]
 HEAVY = {"mujoco", "open3d", "viser"}
 #: layers below "bench" that may import a heavy package (lazily), by package

@@ -48,21 +48,22 @@ def _run(tmp_path: Path, text: str, capsys, name="p.toml"):
     return code, err, out
 
 
-def test_solve_writes_run_folder_in_file_units(tmp_path, capsys):
-    """Units are converted at I/O only: E = 1000 N/mm^2 = 1 GPa, the plate is 100 mm wide; the
-    centre deflection in mm follows Timoshenko's 0.0116 P a^2 / D within the coarse-mesh error."""
+def test_solve_writes_run_folder_in_si(tmp_path, capsys):
+    """Units are converted at I/O only: the problem file is in mm and N (E = 1000 N/mm^2 = 1 GPa,
+    the plate 100 mm wide), the run folder SI; the centre deflection follows Timoshenko's
+    0.0116 P a^2 / D within the coarse-mesh error."""
     code, err, out = _run(tmp_path, BASE, capsys)
     assert code == 0, err
     rec = json.loads((out / "result.json").read_text())
-    assert rec["units"]["length"] == "mm"
-    w = rec["probes"]["centre"]["displacement"][2]
+    assert rec["units"]["length"] == "m"
+    w = rec["probes"]["centre"]["displacement"][2] * 1e3                # mm
     D = 1000.0 * 1.0 ** 3 / (12 * (1 - 0.09))           # N mm
     assert w == pytest.approx(-0.0116008 * 1.0 * 100.0 ** 2 / D, rel=0.02)
-    assert rec["max_displacement"] == pytest.approx(abs(w), rel=1e-3)
+    assert rec["derived"]["max_displacement"]["value"] * 1e3 == pytest.approx(abs(w), rel=1e-3)
     assert rec["n_control"] == 49
-    assert set(rec["timings"]) >= {"assembly", "factor", "solve"}
+    assert set(rec["timings_s"]) >= {"assembly", "factor", "solve"}
     head = (out / "deformed.ply").read_bytes()[:300]
-    assert b"comment units mm" in head
+    assert b"comment units m\n" in head
     assert (out / "problem.toml").read_text() == BASE
 
 
@@ -194,10 +195,10 @@ def test_solve_nonlinear_writes_the_path(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "Newton iterations" in err and "path:" in err
     rec = json.loads((tmp_path / "run" / "result.json").read_text())
-    assert rec["analysis"] == "nonlinear" and rec["completed"] and rec["stable"]
+    assert rec["analysis"] == "nonlinear" and rec["convergence"]["completed"] and rec["stable"]
     rows = (tmp_path / "run" / "path.csv").read_text().strip().splitlines()
-    assert rows[0].startswith("point,kind,load_factor") and "centre_uz[mm]" in rows[0]
-    assert len(rows) == rec["n_points"] + 1 and float(rows[-1].split(",")[2]) == 1.0
+    assert rows[0].startswith("point,kind,load_factor") and "centre_uz[m]" in rows[0]
+    assert len(rows) == rec["convergence"]["n_points"] + 1 and float(rows[-1].split(",")[2]) == 1.0
     lin = tmp_path / "lin.toml"
     lin.write_text(NONLINEAR.replace('type = "nonlinear"\nsteps = 4', 'type = "linear"'))
     assert main(["solve", str(lin), "--out", str(tmp_path / "lin")]) == 0
@@ -213,7 +214,8 @@ def test_a_stopped_path_keeps_its_converged_part_and_exits_2(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "max_steps" in err and "converged part" in err
     rec = json.loads((tmp_path / "run" / "result.json").read_text())
-    assert not rec["completed"] and rec["load_factor"] < 1 and "max_steps" in rec["stop_reason"]
+    conv = rec["convergence"]
+    assert not conv["completed"] and conv["load_factor"] < 1 and "max_steps" in conv["stop_reason"]
 
 
 @pytest.mark.parametrize("edit,message", [

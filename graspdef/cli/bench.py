@@ -42,8 +42,8 @@ def run(args: argparse.Namespace) -> int:
         Path(args.json).write_text(json.dumps(records, indent=2, default=float) + "\n")
         say(f"wrote {args.json}")
     if args.out:
-        from ..geometry.io import atomic_folder
-        from ..geometry.provenance import write_provenance
+        from ..runs.folder import atomic_folder
+        from ..runs.provenance import write_provenance
 
         with atomic_folder(args.out) as tmp:
             (tmp / "bench.json").write_text(json.dumps(records, indent=2, default=float) + "\n")

@@ -35,14 +35,15 @@ def run(a: argparse.Namespace) -> int:
     E = None if getattr(a, "E_MPa", None) is None else quantity(a.E_MPa, "pressure", implied="MPa", what="--E-MPa")
     run = run_grasp(a.scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E)
     r = run.result
-    fb = r["feedback"]
-    ind = fb.get("indentation_per_finger_m", fb.get("indentation_m", 0.0))
-    stop = "" if r["convergence"]["completed"] else \
-        f" (path stopped at load factor {r['convergence'].get('load_factor', 0):.3g})"
+    d = r["derived"]
+    ind = d.get("indentation_per_finger", d.get("indentation"))
+    conv = r["convergence"]
+    stop = "" if conv["completed"] else f" (path stopped at load factor {conv.get('load_factor', 0):.3g})"
     model = "point loads" if r["contact"] == "point" else "geometric contact"
-    area = f", contact area {r['contact_area_m2'] * 1e6:.1f} mm^2" if r["contact"] == "geometric" else ""
-    print(f"{r['object']}: {r['analysis']} shell, {model}, {r['force_N']:g} N per finger: indentation "
-          f"{ind * 1e3:.2f} mm per finger, max displacement {r['max_displacement_m'] * 1e3:.2f} mm{area}{stop}; "
+    area = f", {d['contact_area']['label']} {d['contact_area']['value'] * 1e6:.1f} mm^2" if "contact_area" in d else ""
+    print(f"{r['object']}: {r['analysis']} shell, {model}, {r['force_N']:g} N per finger: {ind['label']} "
+          f"{ind['value'] * 1e3:.2f} mm{' per finger' if 'indentation_per_finger' in d else ''}, "
+          f"{d['max_displacement']['label']} {d['max_displacement']['value'] * 1e3:.2f} mm{area}{stop}; "
           f"{r['timings_s']['total']:.1f} s")
     print(f"run folder: {run.out}")
     progress(a, f"look at it: graspdef report {run.out}, or graspdef view {run.out}")

@@ -57,10 +57,12 @@ def run(args: argparse.Namespace) -> int:
         progress(args, "solved: " + ", ".join(f"{k} {v:.2f} s" for k, v in sol.timings.items()))
     out = write_run(args.out, spec, sol, Path(args.problem).read_text())
     rec = result_record(spec, sol)
+    ls = spec.length_scale                 # the record is SI; the lines speak the problem file's unit
     for name, p in rec["probes"].items():
-        progress(args, f"probe {name}: u = [{', '.join(f'{c:.6g}' for c in p['displacement'])}] {unit}")
+        progress(args, f"probe {name}: u = [{', '.join(f'{c / ls:.6g}' for c in p['displacement'])}] {unit}")
     files = "result.json, deformed.ply, undeformed.ply" + (", path.csv" if rec["analysis"] == "nonlinear" else "")
-    progress(args, f"max displacement {rec['max_displacement']:.6g} {unit}; wrote {out}/ ({files})")
+    md = rec.derived["max_displacement"]
+    progress(args, f"{md['label']} {md['value'] / ls:.6g} {unit}; wrote {out}/ ({files}, SI units)")
     if stopped is not None:
         raise stopped.__class__(f"{stopped} (the converged part of the path is in {out})", stopped.solution)
     return 0

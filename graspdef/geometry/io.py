@@ -2,10 +2,7 @@
 
 from __future__ import annotations
 
-import contextlib
 import re
-import shutil
-import tempfile
 from collections.abc import Mapping
 from os import PathLike
 from pathlib import Path
@@ -147,20 +144,3 @@ def save_ply(path: str | PathLike, vertices: np.ndarray, faces: np.ndarray, *,
         else:
             np.savetxt(fh, np.column_stack(list(columns.values())), fmt="%.17g")
             np.savetxt(fh, np.column_stack([np.full(faces.shape[0], 3), faces]), fmt="%d")
-
-
-@contextlib.contextmanager
-def atomic_folder(out: str | PathLike):
-    """Write a folder atomically: yields a temporary folder beside ``out`` that replaces ``out``
-    only if the block finishes; on any error it is removed and ``out`` is left as it was."""
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
-        yield tmp
-        if out.exists():
-            shutil.rmtree(out)
-        tmp.rename(out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise

@@ -15,13 +15,18 @@ The chain (issue 5):
    are the residual); a fixed object (the duck-head poke) by point supports from object.toml;
 5. linear or nonlinear solve; the indentation (approach of the contact points) is fed back:
    predicted finger gap = rigid-proxy gap - approach, mismatch against MuJoCo's gap reported;
-6. the run folder, written atomically: result.json, contacts.json, deformed.ply,
-   undeformed.ply (limit surface, metres), path.csv (nonlinear).
+6. the run folder, written by the one writer (graspdef.runs.write_run): result.json (with the
+   derived quantities and their definitions), contacts.json, deformed.ply / .vtu, undeformed.ply,
+   path.csv (nonlinear).
+
+Each step is a stage with a typed input and output, testable alone:
+:func:`prepare_object` -> :class:`GraspObject`; :func:`settle` -> :class:`Settled`;
+:func:`shell_problem` -> :class:`ShellSetup`; :func:`solve_shell` -> :class:`Solved`;
+:func:`grasp_record` -> :class:`GraspOutcome` (the run record and the arrays the folder holds);
+:func:`write_grasp_run`.  :func:`run_grasp` chains them.
 """
 from __future__ import annotations
 
-import csv
-import json
 import logging
 import time
 from dataclasses import dataclass
@@ -31,58 +36,92 @@ import numpy as np
 
 from ..contact.mapping import map_contacts
 from ..errors import ProblemError
-from ..geometry.io import atomic_folder, save_ply
-from ..geometry.provenance import write_provenance
 from ..objects import build_shell, load_object, scene_xml
 from ..problem.loads import BodyForce
 from ..problem.potentials import EnclosedGas
 from ..problem.problem import Problem
 from ..problem.supports import PointSupport, RigidModes
+from ..runs import derived as D
+from ..runs.record import SI_UNITS, RunRecord
+from ..runs.write import write_run
+from ..shell.energy import ShellEnergy
 from ..sim.grasp import GraspSettings, grasp
 from ..solve.linear import solve_linear
 from ..solve.nonlinear import PathOptions, PathStopped, solve_nonlinear
+from ..solve.output import path_rows
 
 log = logging.getLogger(__name__)
 
 
 @dataclass
 class GraspRun:
-    out: Path
-    result: dict
+    out: Path | None
+    result: dict          # the run record as its JSON document
 
 
-def _rigid_fit_residual(x: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """u minus its least-squares infinitesimal rigid motion (translation + rotation about the
-    centroid): the deformation part."""
-    c = x.mean(axis=0)
-    r = x - c
-    A = np.zeros((3 * len(x), 6))
-    A[:, :3] = np.tile(np.eye(3), (len(x), 1))
-    for k in range(3):
-        e = np.zeros(3)
-        e[k] = 1
-        A[:, 3 + k] = np.cross(e, r).ravel()
-    coef = np.linalg.lstsq(A, u.ravel(), rcond=None)[0]
-    return u - (A @ coef).reshape(-1, 3)
+@dataclass
+class GraspObject:
+    """Stage 1: the object's data and its shell."""
+
+    xml: Path
+    spec: object                   # graspdef.objects ObjectSpec
+    shell: object                  # graspdef.shell.Shell
+    shell_info: dict
+    p0: float                      # enclosed air's initial gauge pressure [Pa] (0: none)
 
 
-def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonlinear", out=None,
-              gas: bool | None = None, settings: GraspSettings = GraspSettings(), control_faces: int | None = None,
-              steps: int | None = None, E: float | None = None) -> GraspRun:
-    """Run the whole chain for ``scene`` at ``force`` [N] per finger; write the run folder ``out``
-    (when given) and return its result record.
+@dataclass
+class Settled:
+    """Stage 2: MuJoCo's settled grasp (contacts, object pose, per-finger forces)."""
+
+    g: object                      # graspdef.sim.grasp.GraspResult
+    targets: dict                  # finger -> target normal force [N]
+
+
+@dataclass
+class ShellSetup:
+    """Stage 3: the shell problem of the settled contacts."""
+
+    problem: Problem
+    mapping: object                # graspdef.contact.mapping.ContactMapping
+    fingertips: list               # geometric contact: the fingertip obstacles (else empty)
+    free: bool                     # a free body (rigid modes removed) or one held by point supports
+    probes: dict
+    residual_F: np.ndarray
+    residual_M: np.ndarray
+
+
+@dataclass
+class Solved:
+    """Stage 4: the solution (complete, or where its path stopped)."""
+
+    sol: object
+    completed: bool
+    stop_reason: str | None
+
+
+@dataclass
+class GraspOutcome:
+    """Stage 5: the run record and the arrays the run folder holds (SI)."""
+
+    record: RunRecord
+    rest: np.ndarray               # (n, 3) limit surface at rest [m]
+    deformed: np.ndarray           # (n, 3) deformed limit surface [m]
+    faces: np.ndarray
+    displacement: np.ndarray       # (n, 3) the field of derived.max_displacement [m]
+    contacts: dict                 # contacts.json
+    path: tuple | None             # (header, rows) of path.csv
+
+
+def prepare_object(scene, analysis: str = "nonlinear", gas: bool | None = None, control_faces: int | None = None,
+                   E: float | None = None) -> GraspObject:
+    """Stage 1: read the object's data beside ``scene`` and build its shell.
 
     ``gas``: None = as object.toml says (nonlinear only); False/True forces the enclosed air off/on
     (on: object.toml's [gas] p0; an error if it gives none).  ``E`` [Pa]: overrides the Young's
     modulus of object.toml's material law."""
-    t0 = time.perf_counter()
-    if contact not in ("point", "geometric"):
-        raise ProblemError(f"contact must be 'point' (the paper's point loads) or 'geometric' (rigid fingertips), "
-                           f"got {contact!r}")
     if analysis not in ("linear", "nonlinear"):
         raise ProblemError(f"analysis must be 'linear' or 'nonlinear', got {analysis!r}")
-    if not np.isfinite(force) or force <= 0:
-        raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
     xml = scene_xml(scene)
     spec = load_object(xml)
     if control_faces:
@@ -98,12 +137,27 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
         p0 = spec.gas.p0 if spec.gas is not None and analysis == "nonlinear" else 0.0
     else:
         p0 = spec.gas.p0 if gas else 0.0
-    t_setup = time.perf_counter()
+    if analysis == "linear" and p0 > 0:
+        raise ProblemError("an enclosed gas needs the nonlinear analysis (p V = const is nonlinear)")
     shell, shell_info = build_shell(spec, analysis)
-    t_shell = time.perf_counter()
-    targets = {s: (force if s in spec.fingers else 0.0) for s in ("left", "right")}
-    g = grasp(xml, targets, spec.body, settings)
-    t_sim = time.perf_counter()
+    return GraspObject(xml, spec, shell, shell_info, p0)
+
+
+def settle(obj: GraspObject, force: float, settings: GraspSettings = GraspSettings()) -> Settled:
+    """Stage 2: close the gripper to ``force`` [N] per finger in MuJoCo and settle."""
+    if not np.isfinite(force) or force <= 0:
+        raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
+    targets = {s: (force if s in obj.spec.fingers else 0.0) for s in ("left", "right")}
+    return Settled(grasp(obj.xml, targets, obj.spec.body, settings), targets)
+
+
+def shell_problem(obj: GraspObject, st: Settled, contact: str = "point") -> ShellSetup:
+    """Stage 3: the contacts as loads on the shell (point loads, or rigid fingertips), the weight,
+    the enclosed air, the supports and the probes."""
+    if contact not in ("point", "geometric"):
+        raise ProblemError(f"contact must be 'point' (the paper's point loads) or 'geometric' (rigid fingertips), "
+                           f"got {contact!r}")
+    shell, spec, g = obj.shell, obj.spec, st.g
     cs = g.contacts.transformed(g.pose)
     mapping = map_contacts(shell, cs)
     loads = list(mapping.loads)
@@ -111,7 +165,7 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     if contact == "geometric":      # fingertips as rigid obstacles; MuJoCo's other force parts stay dead loads
         from .geometric import finger_contacts
 
-        loads, fingertips = finger_contacts(mapping, g, targets, spec.thickness)
+        loads, fingertips = finger_contacts(mapping, g, st.targets, spec.thickness)
         loads = loads + fingertips
     g_obj = g.pose.vector_to_object(g.gravity)
     free = bool(g.info.get("free_object", True))
@@ -129,8 +183,8 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
             supports.append(PointSupport(sp.face, sp.bary, name=f"fixed_{i}"))
         if not supports:
             raise ProblemError(f"{spec.file}: a fixed object needs [supports] fixed_points")
-    if p0 > 0:
-        loads.append(EnclosedGas(p0) if spec.gas.p_atm is None else EnclosedGas(p0, spec.gas.p_atm))
+    if obj.p0 > 0:
+        loads.append(EnclosedGas(obj.p0) if spec.gas.p_atm is None else EnclosedGas(obj.p0, spec.gas.p_atm))
     probes = {}
     for s in sorted(set(mapping.finger)):
         idx = [i for i, f in enumerate(mapping.finger) if f == s]
@@ -140,9 +194,12 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     # net force and moment of the assembled dead loads (contacts + weight): what the rigid-mode
     # support has to carry; zero up to MuJoCo's settling and the mass discretisation
     fvec = problem.dead_load_vector().reshape(-1, 3)
-    residual_F = fvec.sum(axis=0)
-    residual_M = np.cross(shell.rest_positions, fvec).sum(axis=0)
-    completed, stop_reason = True, None
+    return ShellSetup(problem, mapping, fingertips, free, probes, fvec.sum(axis=0),
+                      np.cross(shell.rest_positions, fvec).sum(axis=0))
+
+
+def solve_shell(setup: ShellSetup, analysis: str, steps: int) -> Solved:
+    """Stage 4: linear or nonlinear solve; a path that stops is returned as far as it got."""
     # contact paths take a few more Newton iterations per step (the barrier stiffens as the patch
     # grows): let the step grow unless a step took more than 8; and they pass close to
     # bifurcations (a ball between two pins may roll), where the branch a load-controlled path
@@ -150,42 +207,48 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     # factorise every converged point (the settings the contact tables were made with; the
     # solver's defaults for smooth paths, reuse_ratio 0.9 and inertia_rtol 1e-4, stop the pinned
     # ball at 12.9 of 20.37 N)
+    fingertips = setup.fingertips
     path_opts = {"desired_iterations": 8, "reuse_ratio": 0.5, "inertia_rtol": 0.0} if fingertips else {}
-    opt = PathOptions(steps=steps or spec.steps, max_steps=40 * (steps or spec.steps), min_step=1e-3, **path_opts)
-    if analysis == "linear" and p0 > 0:
-        raise ProblemError("an enclosed gas needs the nonlinear analysis (p V = const is nonlinear)")
+    opt = PathOptions(steps=steps, max_steps=40 * steps, min_step=1e-3, **path_opts)
     if analysis == "linear" and not fingertips:
-        sol = solve_linear(problem)
-    else:
-        from .geometric import solve_contact
+        return Solved(solve_linear(setup.problem), True, None)
+    from .geometric import solve_contact
 
-        try:
-            sol = solve_contact(problem, opt, linear=analysis == "linear") if fingertips else solve_nonlinear(problem, opt)
-        except PathStopped as exc:
-            sol, completed, stop_reason = exc.solution, False, str(exc)
-    t_solve = time.perf_counter()
-    # displacements and indentation (rigid-motion free)
+    try:
+        sol = solve_contact(setup.problem, opt, linear=analysis == "linear") if fingertips \
+            else solve_nonlinear(setup.problem, opt)
+    except PathStopped as exc:
+        return Solved(exc.solution, False, str(exc))
+    return Solved(sol, True, None)
+
+
+def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solved, force: float, contact: str,
+                 analysis: str, timings: dict) -> GraspOutcome:
+    """Stage 5: displacements (from the unloaded equilibrium, rigid motion removed for a free
+    body), indentation, contact reports, the derived quantities and the run record."""
+    shell, spec, g, sol = obj.shell, obj.spec, st.g, solved.sol
+    mapping, probes, free, fingertips = setup.mapping, setup.probes, setup.free, setup.fingertips
     Lm = sol.limit_map()
     x_lim = Lm @ shell.mesh.vertices
     # displacements from the unloaded equilibrium (load factor 0: the shell inflated by its air,
     # which is the state the scan and MuJoCo's rigid proxy show), not from the stress-free shape
     ref = sol.path[0] if hasattr(sol, "path") else None
     u_lim = sol.vertex_displacements() - (Lm @ ref.u if ref is not None else 0.0)
-    u_def = _rigid_fit_residual(x_lim, u_lim) if free else u_lim
+    u_def = D.rigid_fit_residual(x_lim, u_lim) if free else u_lim
     fingers = {}
     pf = g.per_finger()
+
     def probe(s):
         return sol.probe(s) - (np.asarray(ref.probes[s]) if ref is not None else 0.0)
 
     for s, sp in probes.items():
         u = probe(s)
         n = pf[s]["normal"]
-        fingers[s] = {"target_N": targets[s], "normal_force_N": pf[s]["normal_force"],
+        fingers[s] = {"target_N": st.targets[s], "normal_force_N": pf[s]["normal_force"],
                       "axial_force_N": g.info["axial_force_N"][s],
                       "friction_force_N": pf[s]["friction_force"], "n_contacts": pf[s]["n_contacts"],
                       "load_point_m": mapping.points[[i for i, f in enumerate(mapping.finger) if f == s][0]].tolist(),
                       "displacement_m": u.tolist(), "displacement_along_normal_m": float(u @ g.pose.vector_to_object(n))}
-    feedback = {}
     if len(probes) == 2:
         e = g.pose.vector_to_object(pf["right"]["point"] - pf["left"]["point"])
         sep = float(np.linalg.norm(e))
@@ -201,6 +264,7 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
         s = next(iter(probes))
         ind = fingers[s]["displacement_along_normal_m"]      # along the push: positive = indented
         feedback = {"indentation_m": ind, "mujoco_tip_gap_m": g.tip_gap, "mismatch_m": ind}
+    residual_F = setup.residual_F
     geo = None
     if fingertips:
         from .geometric import contact_reports
@@ -222,66 +286,96 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
         # net force of everything acting on the shell (dead loads + contact forces): what the
         # 3-2-1 support carries
         residual_F = residual_F + sum(np.asarray(r.get("contact_force_N", np.zeros(3))) for r in geo.values())
-    rec = {
-        "scene": str(xml), "object": spec.body, "force_N": force, "contact": contact, "analysis": analysis,
+    reference = "unloaded equilibrium (load factor 0; with air: the inflated shell)" if ref is not None \
+        else "rest shape"
+    derived = {"max_displacement": D.max_displacement(x_lim, u_def, "m", rigid_motion_removed=free,
+                                                      reference=reference)}
+    if "indentation_per_finger_m" in feedback:
+        derived["indentation_per_finger"] = D.entry(
+            feedback["indentation_per_finger_m"], "m", "indentation per finger",
+            "half the approach of the two fingers' load points along the grasp axis" if not geo else
+            "mean travel of the force-controlled fingertips from first touch")
+    else:
+        derived["indentation"] = D.entry(feedback["indentation_m"], "m", "indentation",
+                                         "displacement of the load point along the finger's push")
+    if geo:
+        derived["contact_area"] = D.entry(float(sum(r["contact_area_m2"] for r in geo.values())), "m2",
+                                          "contact area", "sampled surface area with gap < dhat (pressure > 0), "
+                                                          "all fingers")
+    derived["finger_force"] = D.entry({s: f["normal_force_N"] for s, f in fingers.items()}, "N",
+                                      "normal force per finger", "MuJoCo's settled normal contact force of each finger")
+    derived["net_force_residual"] = D.entry(np.linalg.norm(residual_F), "N", "net force residual",
+                                            "|sum of all forces on the shell|: what the rigid-mode support carries")
+    strain = sol.strain_energy if analysis == "linear" and not fingertips else \
+        ShellEnergy(shell).energy(shell.rest_positions + sol.u)
+    derived["strain_energy"] = D.entry(float(strain), "J", "strain energy",
+                                       "elastic energy of the shell at the final state, from its stress-free shape")
+    conv = {"completed": solved.completed, "stop_reason": solved.stop_reason}
+    if hasattr(sol, "path"):
+        conv.update({"load_factor": sol.load_factor, "n_points": len(sol.path),
+                     "newton_iterations": sol.iterations(), "n_factorisations": sol.n_factorisations,
+                     "critical_points": [dict(cp, probes={k: np.asarray(v).tolist() for k, v in cp["probes"].items()})
+                                         for cp in sol.critical_points]})
+    else:
+        conv.update({"relative_residual": sol.kkt.residual})
+    if analysis == "linear" and fingertips:
+        conv["note"] = "linear shell (rest stiffness K0) with contact: a load path of the nonlinear solver"
+    data = {
+        "scene": str(obj.xml), "object": spec.body, "force_N": force, "contact": contact,
         "material": {"model": spec.material.model(analysis), "E_Pa": spec.material.E, "nu": spec.material.nu,
                      "thickness_m": spec.thickness},
-        "gas_p0_Pa": p0, "shell": shell_info,
-        "max_displacement_m": float(np.linalg.norm(u_def, axis=1).max()),
-        "max_displacement_raw_m": float(np.linalg.norm(u_lim, axis=1).max()),
-        "fingers": fingers, "feedback": feedback,
-        "displacement_reference": "unloaded equilibrium (load factor 0; with air: the inflated shell)",
-        "contact_area_m2": float(sum(r["contact_area_m2"] for r in geo.values())) if geo else 0.0,
+        "thickness_m": spec.thickness, "gas_p0_Pa": obj.p0, "shell": obj.shell_info,
+        "fingers": fingers, "feedback": feedback, "displacement_reference": reference,
         "load_mapping": mapping.record(),
         "residual": {"net_force_N": np.asarray(residual_F).tolist(),
-                     "net_moment_Nm": None if geo else np.asarray(residual_M).tolist()},
-        "mujoco": g.record(),
-        "convergence": {"completed": completed, "stop_reason": stop_reason},
-        "timings_s": {"shell_setup": t_shell - t_setup, "mujoco": t_sim - t_shell, "solve": t_solve - t_sim,
-                      "total": time.perf_counter() - t0},
-        "units": "SI (m, N, Pa)",
+                     "net_moment_Nm": None if geo else np.asarray(setup.residual_M).tolist()},
+        "mujoco": g.record(), "convergence": conv, "timings_s": timings,
     }
     if geo:
-        rec["geometric_contact"] = {
+        data["geometric_contact"] = {
             "model": "rigid force-controlled fingertips, IPC log barrier on mid-surface samples against the "
                      "fingertip inflated by t/2", "fingers": geo,
             "contact_area_definition": "sampled surface area with gap < dhat (contact pressure > 0)",
             "friction": "MuJoCo's contact forces less their finger-axis parts, as dead loads at the contacts"}
-    if hasattr(sol, "path"):
-        rec["convergence"].update({"load_factor": sol.load_factor, "n_points": len(sol.path),
-                                   "newton_iterations": sol.iterations(), "n_factorisations": sol.n_factorisations,
-                                   "critical_points": [dict(cp, probes={k: np.asarray(v).tolist() for k, v in cp["probes"].items()})
-                                                       for cp in sol.critical_points]})
-    else:
-        rec["convergence"].update({"relative_residual": sol.kkt.residual})
-    if analysis == "linear" and fingertips:
-        rec["convergence"]["note"] = "linear shell (rest stiffness K0) with contact: a load path of the nonlinear solver"
+    rec = RunRecord("grasp", spec.body, analysis, dict(SI_UNITS), derived, {}, data)
+    verts, faces = sol.deformed_surface()
+    contacts = {"frame": "world", "units": {"length": "m", "force": "N"}, "object_pose": g.pose.record(),
+                "contacts": g.contacts.records(), "per_finger": data["mujoco"]["per_finger"]}
+    path = path_rows(sol) if hasattr(sol, "path") else None
+    return GraspOutcome(rec, x_lim, verts, faces, u_def, contacts, path)
+
+
+def write_grasp_run(out, outcome: GraspOutcome, config: dict) -> Path:
+    """Stage 6: the run folder (graspdef.runs.write_run)."""
+    return write_run(out, outcome.record, rest=outcome.rest, deformed=outcome.deformed, faces=outcome.faces,
+                     displacement=outcome.displacement, path=outcome.path,
+                     json_files={"contacts.json": outcome.contacts}, provenance=config)
+
+
+def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonlinear", out=None,
+              gas: bool | None = None, settings: GraspSettings = GraspSettings(), control_faces: int | None = None,
+              steps: int | None = None, E: float | None = None) -> GraspRun:
+    """Run the whole chain for ``scene`` at ``force`` [N] per finger; write the run folder ``out``
+    (when given) and return its record (see the stages above for the arguments)."""
+    t0 = time.perf_counter()
+    if contact not in ("point", "geometric"):
+        raise ProblemError(f"contact must be 'point' (the paper's point loads) or 'geometric' (rigid fingertips), "
+                           f"got {contact!r}")
+    if not np.isfinite(force) or force <= 0:
+        raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
+    obj = prepare_object(scene, analysis, gas, control_faces, E)
+    t_shell = time.perf_counter()
+    st = settle(obj, force, settings)
+    t_sim = time.perf_counter()
+    setup = shell_problem(obj, st, contact)
+    solved = solve_shell(setup, analysis, steps or obj.spec.steps)
+    t_solve = time.perf_counter()
+    timings = {"shell_setup": t_shell - t0, "mujoco": t_sim - t_shell, "solve": t_solve - t_sim}
+    outcome = grasp_record(obj, st, setup, solved, force, contact, analysis, timings)
+    timings["total"] = time.perf_counter() - t0
     if out is not None:
-        out = Path(out)
         config = {"scene": str(scene), "force_N": force, "contact": contact, "analysis": analysis, "gas": gas,
                   "control_faces": control_faces, "steps": steps, "E_Pa": E, "settings": dict(settings.__dict__),
-                  "object_toml": spec.file.read_text()}
-        _write(out, rec, g, sol, x_lim, u_def, config)
-    return GraspRun(Path(out) if out is not None else None, rec)
-
-
-def _write(out: Path, rec: dict, g, sol, x_lim, u_def, config: dict | None = None) -> None:
-    with atomic_folder(out) as tmp:
-        write_provenance(tmp, config)
-        rec = dict(rec, files={"deformed": "deformed.ply", "undeformed": "undeformed.ply", "contacts": "contacts.json"})
-        (tmp / "result.json").write_text(json.dumps(rec, indent=2, default=float) + "\n")
-        (tmp / "contacts.json").write_text(json.dumps({
-            "frame": "world", "object_pose": g.pose.record(), "contacts": g.contacts.records(),
-            "per_finger": rec["mujoco"]["per_finger"]}, indent=2) + "\n")
-        verts, faces = sol.deformed_surface()
-        save_ply(tmp / "deformed.ply", verts, faces, units="m",
-                 vertex_scalars={"displacement": np.linalg.norm(u_def, axis=1)})
-        save_ply(tmp / "undeformed.ply", x_lim, faces, units="m")
-        if hasattr(sol, "path"):
-            with open(tmp / "path.csv", "w", newline="") as fh:
-                w = csv.writer(fh)
-                names = list(sol.problem.probes)
-                w.writerow(["point", "load_factor", "newton_iterations"] + [f"{n}_u{c}[m]" for n in names for c in "xyz"])
-                for i, p in enumerate(sol.path):
-                    w.writerow([i, p.load_factor, p.iterations] + [float(v) for n in names for v in p.probes[n]])
-
+                  "object_toml": obj.spec.file.read_text()}
+        out = write_grasp_run(out, outcome, config)
+    return GraspRun(Path(out) if out is not None else None, outcome.record.to_json())

@@ -21,8 +21,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from graspdef.geometry import TriMesh, compile_predicate, length_scale, save_ply
-from graspdef.geometry.io import atomic_folder
-from graspdef.geometry.provenance import write_provenance
+from graspdef.runs.folder import atomic_folder
+from graspdef.runs.provenance import write_provenance
 from graspdef.registration.distance import SurfaceDistance
 from graspdef.registration.icp import (
     Registration,

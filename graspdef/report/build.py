@@ -1,11 +1,11 @@
 """The report of one or more run folders: one self-contained HTML page.
 
-Per run folder (read with :func:`graspdef.viewer.read_run`, so a report accepts exactly the
-folders the viewer accepts):
+Per run folder (read with :func:`graspdef.runs.read_run`, the reader every consumer uses):
 
-* the run's summary from ``result.json`` (units stated);
-* the deformed surface coloured by the displacement magnitude (mm; for grasp runs with the
-  best-fit rigid motion removed, as ``max_displacement_m`` in result.json);
+* the run's summary from ``result.json`` (units stated), its derived quantities with their labels;
+* the deformed surface coloured by the stored displacement field (``deformed.ply``'s ux, uy, uz:
+  the field whose maximum is ``derived.max_displacement``, so table, caption and colour bar
+  agree with each other and with the viewer);
 * with a score (``score.json`` + ``scan_errors.ply`` of ``graspdef score`` in the run folder or a
   sub-folder, or made here from ``scan=``): the surface coloured by the signed scan error of the
   nearest scan point (grey where the scanner saw nothing), the prediction-vs-undeformed error
@@ -31,7 +31,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import GraspdefError
-from ..viewer.runs import RunData, read_run
+from ..runs.read import RunData, read_run
 from . import html as H
 from .plots import bar_chart, line_chart, load_deflection, newton_iterations
 from .render import render_surface
@@ -77,7 +77,7 @@ class RunReport:
     def stopped_at(self) -> float | None:
         """The load factor where an incomplete nonlinear path stopped, else None."""
         rec = self.run.record
-        conv = rec.get("convergence") if isinstance(rec.get("convergence"), dict) else rec
+        conv = rec.get("convergence") or {}
         if self.run.analysis == "nonlinear" and conv.get("completed") is False:
             return float(conv.get("load_factor", float("nan")))
         return None
@@ -89,39 +89,16 @@ class RunReport:
     @property
     def to_display(self) -> float:
         """Display length per metre of the run's SI data (mm, or the consistent unit)."""
-        return 1.0 if self.run.length_unit == "consistent" else MM
+        return 1.0 / self.run.display_scale
 
     def max_displacement(self) -> float | None:
-        """Largest displacement in display units (mm): result.json's value."""
-        rec = self.run.record
-        if "max_displacement_m" in rec:
-            return float(rec["max_displacement_m"]) * MM
-        if "max_displacement" in rec:
-            return float(rec["max_displacement"]) * self.run.length_scale * self.to_display
-        return None
+        """``derived.max_displacement`` in display units (mm)."""
+        md = self.run.max_displacement()
+        return None if md is None else float(md) * self.to_display
 
     def displacement_field(self) -> tuple[np.ndarray, str]:
-        """|u| per vertex in display units, and what it is."""
-        u = self.run.displacements
-        what = "|u|"
-        if "max_displacement_raw_m" in self.run.record:       # grasp runs: free body, rigid motion removed
-            u = rigid_fit_residual(self.run.rest_vertices, u)
-            what = "|u| (rigid motion removed)"
-        return np.linalg.norm(u, axis=1) * self.to_display, what
-
-
-def rigid_fit_residual(x: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """``u`` minus its least-squares infinitesimal rigid motion about the centroid of ``x`` (the
-    grasp pipeline's definition of the deformation part)."""
-    r = x - x.mean(axis=0)
-    A = np.zeros((3 * len(x), 6))
-    A[:, :3] = np.tile(np.eye(3), (len(x), 1))
-    for k in range(3):
-        e = np.zeros(3)
-        e[k] = 1.0
-        A[:, 3 + k] = np.cross(e, r).ravel()
-    coef = np.linalg.lstsq(A, u.ravel(), rcond=None)[0]
-    return u - (A @ coef).reshape(-1, 3)
+        """|u| per vertex in display units (the stored field), and what it is."""
+        return np.linalg.norm(self.run.displacements, axis=1) * self.to_display, self.run.displacement_label
 
 
 def paper_row(force_N: float | None, obj: str | None = None) -> dict | None:
@@ -165,8 +142,8 @@ def score_run(run_dir: Path, scan: str, *, out: Path | None = None, surface_offs
               scan_units: str | None = None) -> Path:
     """Score ``RUN_DIR/deformed.ply`` against ``scan`` (a file or a manifest id) with
     :func:`graspdef.registration.score_cli`; written to ``out`` (default ``RUN_DIR/score``).
-    The surface offset defaults to half the shell thickness of a grasp run (the scan sees the
-    outer surface, the run holds the mid-surface)."""
+    The surface offset defaults to half the shell thickness of the run (the scan sees the outer
+    surface, the run holds the mid-surface): the same default as ``graspdef score RUN_DIR``."""
     from ..registration import score_cli
 
     run = read_run(run_dir)
@@ -174,8 +151,7 @@ def score_run(run_dir: Path, scan: str, *, out: Path | None = None, surface_offs
         raise ReportError(f"run folder {run_dir} is in consistent units: it cannot be compared with a scan "
                           "(give the problem file physical units)")
     if surface_offset_mm is None:
-        t = (run.record.get("material") or {}).get("thickness_m")
-        surface_offset_mm = 0.5 * float(t) * MM if t else 0.0
+        surface_offset_mm = run.outer_offset * MM
     out = Path(out) if out is not None else Path(run_dir) / "score"
     score_cli(Path(run_dir) / "deformed.ply", scan, out, scan_units=scan_units, surface_offset_mm=surface_offset_mm)
     return out
@@ -216,8 +192,7 @@ def read_table_file(path: str | PathLike) -> list[tuple[Path, float | None, floa
 # ------------------------------------------------------------------------------------------------
 def _summary_rows(rr: RunReport) -> list[tuple[str, str]]:
     rec, run = rr.run.record, rr.run
-    units = rec.get("units")
-    units_text = units if isinstance(units, str) else ", ".join(f"{k} {v}" for k, v in (units or {}).items())
+    units_text = ", ".join(f"{k} {v}" for k, v in rec.units.items())
     rows = [("folder", str(run.path)), ("analysis", run.analysis), ("units of the run", units_text)]
     if "object" in rec:
         rows.append(("object (scene)", f"{rec['object']} ({Path(str(rec.get('scene', ''))).parent.name})"))
@@ -236,17 +211,14 @@ def _summary_rows(rr: RunReport) -> list[tuple[str, str]]:
     if rec.get("gas_p0_Pa"):
         rows.append(("enclosed air [kPa]", H.fmt(rec["gas_p0_Pa"] / 1e3)))
     rows.append(("surface vertices / faces", f"{len(run.rest_vertices):,} / {len(run.faces):,}"))
-    md = rr.max_displacement()
-    if md is not None:
-        rows.append((f"max. displacement [{rr.length_label}]", H.fmt(md)))
-    fb = rec.get("feedback") or {}
-    if "indentation_per_finger_m" in fb:
-        rows.append(("indentation per finger [mm]", H.fmt(fb["indentation_per_finger_m"] * MM)))
+    for d in rec.derived.values():
+        label, value = derived_display(d, run.display_unit)
+        rows.append((label, value))
     for name, p in (rec.get("probes") or {}).items():
         if isinstance(p, dict) and "displacement" in p:
-            rows.append((f"probe {name}: u [{run.length_unit}]",
-                         "(" + ", ".join(H.fmt(c) for c in p["displacement"]) + ")"))
-    conv = rec.get("convergence") if isinstance(rec.get("convergence"), dict) else rec
+            rows.append((f"probe {name}: u [{rr.length_label}]",
+                         "(" + ", ".join(H.fmt(c * rr.to_display) for c in p["displacement"]) + ")"))
+    conv = rec.get("convergence") or {}
     if run.analysis == "nonlinear":
         rows.append(("path completed", H.fmt(bool(conv.get("completed", True)))))
         if conv.get("stop_reason"):
@@ -262,6 +234,25 @@ def _summary_rows(rr: RunReport) -> list[tuple[str, str]]:
     if isinstance(tim, dict) and tim:
         rows.append(("timings [s]", ", ".join(f"{k} {v:.3g}" for k, v in tim.items() if isinstance(v, (int, float)))))
     return rows
+
+
+#: SI unit -> (display unit, factor) for the report's tables
+_DISPLAY = {"m": ("mm", 1e3), "m2": ("mm^2", 1e6), "J": ("mJ", 1e3), "N": ("N", 1.0), "Pa": ("kPa", 1e-3)}
+
+
+def derived_display(d: dict, display_length: str = "mm") -> tuple[str, str]:
+    """A derived quantity's table row: ``label [unit]`` and its value (a number, a per-finger
+    mapping or a vector) in display units; the definition goes into the label's tooltip text."""
+    unit = d.get("unit", "")
+    shown, f = _DISPLAY.get(unit, (unit, 1.0)) if display_length != "consistent" else (unit, 1.0)
+    v = d["value"]
+    if isinstance(v, dict):
+        text = ", ".join(f"{k} {H.fmt(x * f)}" for k, x in v.items())
+    elif isinstance(v, (list, tuple)):
+        text = "(" + ", ".join(H.fmt(x * f) for x in v) + ")"
+    else:
+        text = H.fmt(None if v is None else v * f)
+    return f"{d.get('label', '?')} [{shown}]", text
 
 
 def _scan_error_colours(rr: RunReport) -> np.ndarray:
@@ -299,11 +290,14 @@ def _run_section(rr: RunReport, views, index: int) -> list[str]:
         out.append(f"<div class=\"flag\">{H.esc(n)}</div>")
     out.append(H.table(["run", "value"], _summary_rows(rr), left=2, table_id=f"summary-{index}"))
     mag, what = rr.displacement_field()
-    figs = [H.img(render_surface(run.deformed_vertices, run.faces, mag, views=views, label=f"{what} [{rr.length_label}]",
+    top = float(np.nanmax(mag))          # = derived.max_displacement: the colour bar spans 0 .. this
+    figs = [H.img(render_surface(run.deformed_vertices, run.faces, mag, views=views, vmin=0.0, vmax=top,
+                                 label=f"{what} [{rr.length_label}]",
                                  title=f"{run.name}: deformed surface, {what}"),
                   alt=f"deformed surface of {run.name} coloured by displacement",
                   caption=f"Deformed surface (true scale) coloured by {what} in {rr.length_label}; "
-                          f"largest {np.nanmax(mag):.4g} {rr.length_label}.")]
+                          f"largest {top:.4g} {rr.length_label} (max. displacement: "
+                          f"{(run.record.derived.get('max_displacement') or {}).get('definition', '')}).")]
     if rr.score is not None:
         err = _scan_error_colours(rr)
         lim = float(np.nanpercentile(np.abs(err), 99)) if np.isfinite(err).any() else 1.0

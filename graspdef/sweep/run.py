@@ -15,7 +15,7 @@ Resume semantics (see docs/sweep.md):
 
 * a case is *final* when ``cases/<id>/case.json`` exists; the worker writes the case's folder
   (run files + case.json) in a temporary folder and renames it into place in one step
-  (:func:`graspdef.geometry.io.atomic_folder`), so a case is either complete on disk or absent;
+  (:func:`graspdef.runs.folder.atomic_folder`), so a case is either complete on disk or absent;
 * a killed worker loses only the case it was running (dask reschedules it on another worker;
   its temporary folder is removed at the end of the sweep);
 * a case that raises is submitted once more; a second failure is recorded as
@@ -45,8 +45,8 @@ from pathlib import Path
 from typing import Callable
 
 from ..errors import GraspdefError
-from ..geometry.io import atomic_folder
-from ..geometry.provenance import write_provenance
+from ..runs.folder import atomic_folder
+from ..runs.provenance import write_provenance
 from ..units import PRESSURE_UNITS, format_quantity
 from .spec import Case, SweepSpec
 
@@ -136,7 +136,7 @@ def _key_results(r: dict) -> dict:
     conv = r.get("convergence", {})
     net = r.get("residual", {}).get("net_force_N", [0.0, 0.0, 0.0])
     return {
-        "max_displacement_m": r["max_displacement_m"],
+        "max_displacement_m": r["derived"]["max_displacement"]["value"],       # the run record's, same definition
         "indentation_m": fb.get("indentation_per_finger_m", fb.get("indentation_m")),
         "completed": conv.get("completed"),
         "load_factor": conv.get("load_factor", 1.0 if conv.get("completed") else None),

@@ -26,7 +26,7 @@ from ..shell.energy import ShellEnergy
 from ..solve.nonlinear import PathOptions, PathSolver, path_options, solve_nonlinear
 from ..solve.sparse import KKTSystem
 from ..subdivision.rules import limit_matrix
-from .runs import RunData
+from ..runs.read import RunData
 
 log = logging.getLogger(__name__)
 
@@ -81,7 +81,7 @@ class LiveModel:
                                                                tol=opts.tol, line_search=True), backend)
             eq = self.solver.eq
             self.modulus_ok = not (eq.m and np.any(eq.g)) and not any(isinstance(p, EnclosedGas) for p in eq.potentials)
-            self.lam_end = float(run.record.get("load_factor", opts.max_load))
+            self.lam_end = float((run.record.get("convergence") or {}).get("load_factor", opts.max_load))
             self.u = None                                  # (3 n_control,) current converged state
             self.lam = None
         else:

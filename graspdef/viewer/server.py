@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import GraspdefError
 from . import layers
-from .runs import RunData, read_run
+from ..runs.read import RunData, read_run
 
 log = logging.getLogger(__name__)
 
@@ -178,8 +178,8 @@ class _RunView:
                 self.rest_handle.visible = mode != "deformed"
                 self.rest_handle.opacity = 0.35 if mode == "both" else None
             self.displayed = verts
-        ls = run.length_scale
-        self.legend.content = layers.legend_html("displacement |u|", run.length_unit, 0.0, self.vmax / ls)
+        ls = run.display_scale
+        self.legend.content = layers.legend_html(run.displacement_label, run.display_unit, 0.0, self.vmax / ls)
 
     def pick(self, origin, direction) -> str:
         """The numbers at the surface point under a click (a ray in display coordinates): the
@@ -191,7 +191,7 @@ class _RunView:
         dist = np.linalg.norm(x - t[:, None] * dvec, axis=1)
         near = dist < max(2.0 * float(dist.min()), 0.02)
         i = int(np.flatnonzero(near)[np.argmin(t[near])])             # the front-most close vertex
-        ls, lu = self.run.length_scale, self.run.length_unit
+        ls, lu = self.run.display_scale, self.run.display_unit
         u = self.disp[i] / ls
         text = (f"**picked vertex {i}**: |u| = {np.linalg.norm(u):.4g} {lu}, "
                 f"u = ({u[0]:.3g}, {u[1]:.3g}, {u[2]:.3g}) {lu}")
@@ -206,10 +206,13 @@ class _RunView:
 
     def _update_info(self, extra: str = "") -> None:
         run = self.run
-        ls = run.length_scale
-        lines = [f"**{run.analysis}** run `{run.path.name}` · units: {run.length_unit}, {run.force_unit}",
+        ls = run.display_scale
+        lines = [f"**{run.analysis}** run `{run.path.name}` · units: {run.display_unit}, {run.force_unit}",
                  f"showing: {self.source} · max |u| = {np.linalg.norm(self.disp, axis=1).max() / ls:.4g} "
-                 f"{run.length_unit}"]
+                 f"{run.display_unit}"]
+        md = run.record.derived.get("max_displacement")
+        if md is not None:                     # the run's own number, with its definition (as in the report)
+            lines.append(f"{md['label']} of the run: {md['value'] / ls:.4g} {run.display_unit} ({md['definition']})")
         lines += [f"*{n}*" for n in run.notes]
         lines.append(getattr(self, "picked", None) or "*click the surface for the numbers at a point*")
         if extra:
@@ -226,10 +229,10 @@ class _RunView:
             return
         name, p = next(iter(t.probes.items()))
         comp = int(np.argmax(np.ptp(p, axis=0)))
-        x = p[:, comp] / self.run.length_scale
+        x = p[:, comp] / self.run.display_scale
         self.chart.content = layers.chart_svg(x, t.load_factors, self.step if self.source.startswith("path") or
                                               self.source == "final state" else None,
-                                              f"{name} u{'xyz'[comp]} [{self.run.length_unit}]", "load factor",
+                                              f"{name} u{'xyz'[comp]} [{self.run.display_unit}]", "load factor",
                                               extra=live_point)
 
 
@@ -394,11 +397,11 @@ class Viewer:
                 rv.force_slider = gui.add_slider("load × run's load", 0.0, 3.0, 0.01, 1.0)
             name, e0 = m.modulus_name, m.modulus0
             if name == "E":
-                lu = rv.run.length_unit
+                lu = rv.run.display_unit
                 if lu == "consistent" or fu == "consistent":
                     unit, es = "consistent", 1.0
                 else:
-                    unit, es = f"{fu}/{lu}²", fs / rv.run.length_scale ** 2
+                    unit, es = f"{fu}/{lu}²", fs / rv.run.display_scale ** 2
                 rv.modulus_ref = e0 / es
                 rv.modulus_slider = gui.add_slider(f"Young's modulus E [{unit}]", float(0.2 * rv.modulus_ref),
                                                    float(5 * rv.modulus_ref), float(rv.modulus_ref / 100),
@@ -513,7 +516,7 @@ class Viewer:
                         if pt is not None:
                             st, w = rv.live.problem.evaluator.values(pt.face, np.asarray(pt.bary))
                             up = w @ rv.live.u.reshape(-1, 3)[st]
-                            rv._update_chart((float(up[comp] / rv.run.length_scale), float(res.load_factor)))
+                            rv._update_chart((float(up[comp] / rv.run.display_scale), float(res.load_factor)))
                 rv.live_status.content = f"**converged** in {res.seconds:.2f} s — {res.message}"
             else:
                 rv.live_status.content = f"**not converged** ({res.seconds:.2f} s): {res.message}"

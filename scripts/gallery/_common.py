@@ -141,15 +141,13 @@ def convergence_axes(ax, name: str, rows: list[dict], **kw) -> None:
 # ---- grasp run folders (paper Figs. 13-15) ------------------------------------------------------
 
 def run_surfaces(run_dir: Path) -> dict:
-    """The undeformed and deformed limit surfaces of a grasp run folder (metres) and the
-    rigid-motion-free displacement magnitude per vertex (the 'displacement' scalar of deformed.ply)."""
-    import trimesh
-    d = trimesh.load(Path(run_dir) / "deformed.ply", process=False, force="mesh")
-    u = trimesh.load(Path(run_dir) / "undeformed.ply", process=False, force="mesh")
-    raw = d.metadata.get("_ply_raw", {}).get("vertex", {}).get("data")
-    mag = np.asarray(raw["displacement"], float).ravel()
-    return {"undeformed": np.asarray(u.vertices), "deformed": np.asarray(d.vertices),
-            "faces": np.asarray(d.faces), "u_mag": mag}
+    """The undeformed and deformed limit surfaces of a run folder (metres) and the magnitude of
+    the stored displacement field per vertex (the field of derived.max_displacement), read with
+    graspdef's one run reader."""
+    from graspdef.runs.read import read_run
+    r = read_run(run_dir)
+    return {"undeformed": r.rest_vertices, "deformed": r.deformed_vertices, "faces": r.faces,
+            "u_mag": np.linalg.norm(r.displacements, axis=1), "record": r.record}
 
 
 def convergence_figure(name: str, rows: list[dict], reference: float, ref_label: str, column: str,

@@ -20,7 +20,6 @@ dominate (far-field |u| below the indentation).
 """
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -41,7 +40,7 @@ def main(argv: list[str] | None = None) -> dict:
     g = grasp_record("tennis_ball", FORCE_N, "nonlinear", a.contact, run_dir, control_faces=320 if a.fast else None)
     s = C.run_surfaces(run_dir)
     mag = s["u_mag"]
-    res = json.loads((run_dir / "result.json").read_text())
+    res = C.run_surfaces(run_dir)["record"]
     x = s["undeformed"]
     dist = {k: np.linalg.norm(x - np.asarray(v["load_point_m"]), axis=1) for k, v in res["fingers"].items()}
     at_contact = {k: 1e3 * float(mag[np.argmin(d)]) for k, d in dist.items()}   # rigid motion removed

@@ -22,7 +22,6 @@ contacts' total force and moment (defects at round-off) and both contact points 
 """
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -54,7 +53,7 @@ def calibrated_grasp(scene: str, force: float, measured_mm: float, out: Path, fa
 
 def finger_numbers(run_dir: Path) -> dict:
     """Per finger: axial and normal force [N], displacement along the contact normal [mm]."""
-    res = json.loads((run_dir / "result.json").read_text())
+    res = C.run_surfaces(run_dir)["record"]
     return {s: {"axial_N": v["axial_force_N"], "normal_N": v["normal_force_N"],
                 "along_normal_mm": 1e3 * v["displacement_along_normal_m"]} for s, v in res["fingers"].items()}
 

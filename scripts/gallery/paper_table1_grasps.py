@@ -52,7 +52,7 @@ def grasp_record(scene: str, force: float, analysis: str, contact: str = "point"
     return {"scene": scene, "force_N": force, "analysis": analysis, "gas_kPa": r["gas_p0_Pa"] / 1e3,
             "E_MPa": r["material"]["E_Pa"] / 1e6,
             "indentation_mm": 1e3 * fb.get("indentation_per_finger_m", fb.get("indentation_m", float("nan"))),
-            "max_displacement_mm": 1e3 * r["max_displacement_m"], "completed": conv["completed"],
+            "max_displacement_mm": 1e3 * r["derived"]["max_displacement"]["value"], "completed": conv["completed"],
             "load_factor": conv.get("load_factor", 1.0),
             "contact_separation_mm": 1e3 * fb.get("rigid_contact_separation_m", float("nan")),
             "finger_normal_N": {s: v["normal_force_N"] for s, v in r["fingers"].items()},

@@ -7,14 +7,13 @@ def test_fig06_point_loads(run_fast):
     (1) the flattened saddle is the simply supported square plate under a central point load,
     0.0116008 P a^2 / D = 69.60 (Timoshenko; ../shared/BENCHMARKS.md 2.1), within 1 %;
     (2) the half ellipsoid with equal axes (a hemisphere, R/t = 50) gives Reissner's apex
-    deflection sqrt(3 (1 - nu^2)) P R / (4 E t^2) = 0.4131 within 5 % (BENCHMARKS.md 2.4);
-    (3) the coarse saddle is below the converged full-mode value 3.73 (40 x 40; 3.74 at 80 x 80)
-    and within 5 % of it."""
+    deflection sqrt(3 (1 - nu^2)) P R / (4 E t^2) = 0.4131 within 5 % (BENCHMARKS.md 2.4).
+    The saddle's own value (3.73 converged, the paper's 28.6) has no independent reference: it is
+    reported in the gallery, not asserted against our own earlier output."""
     k = run_fast("paper_fig06_point_loads")["key"]
     assert abs(k["flattened_saddle_m"] / k["kirchhoff_plate_m"] - 1) < 0.01, k
     assert abs(k["kirchhoff_plate_m"] - 69.6048) < 1e-3
     assert abs(k["hemisphere_apex_m"] / k["reissner_m"] - 1) < 0.05, k
-    assert 0.95 * 3.73 < k["saddle_max_displacement_m"] < 3.73, k
 
 
 def test_fig08_plate_convergence(run_fast):

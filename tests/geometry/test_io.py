@@ -72,7 +72,7 @@ def test_save_ply_rejects_bad_scalars(tmp_path):
 def test_atomic_folder_replaces_only_on_success(tmp_path):
     """A folder written through atomic_folder appears whole or not at all: an error inside the
     block leaves the previous folder untouched and no temporary folder behind."""
-    from graspdef.geometry.io import atomic_folder
+    from graspdef.runs.folder import atomic_folder
 
     out = tmp_path / "run"
     with atomic_folder(out) as d:

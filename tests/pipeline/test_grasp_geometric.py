@@ -35,9 +35,9 @@ def test_tennis_ball_pads_geometric_nonlinear(tmp_path):
     _check(r, 3.0)
     ind = r["feedback"]["indentation_per_finger_m"]
     assert 0 < ind < 5e-3
-    assert r["contact_area_m2"] / 2 > 2e-5                      # > 20 mm^2 per pad
+    assert r["derived"]["contact_area"]["value"] / 2 > 2e-5                      # > 20 mm^2 per pad
     rec = json.loads((out / "result.json").read_text())
-    assert rec["contact"] == "geometric" and rec["contact_area_m2"] > 0
+    assert rec["contact"] == "geometric" and rec["derived"]["contact_area"]["value"] > 0
     for f in ("result.json", "contacts.json", "deformed.ply", "undeformed.ply", "path.csv"):
         assert (out / f).is_file()
 
@@ -49,6 +49,6 @@ def test_tennis_ball_contact_area_grows_with_load():
     rs = [run_grasp(PADS, f, "geometric", "linear", None, control_faces=320).result for f in (1.0, 3.0)]
     for r, f in zip(rs, (1.0, 3.0)):
         _check(r, f)
-    assert rs[0]["contact_area_m2"] < rs[1]["contact_area_m2"]
+    assert rs[0]["derived"]["contact_area"]["value"] < rs[1]["derived"]["contact_area"]["value"]
     i0, i1 = (r["feedback"]["indentation_per_finger_m"] for r in rs)
     assert 0 < i0 < i1

@@ -104,16 +104,17 @@ def cantilever_run(report_root) -> Path:
 @pytest.fixture(scope="session")
 def ball_scan(report_root, ball_run) -> Path:
     """A synthetic scan (scanner model: 6 views, holes, sigma = 0.127 mm, random pose; 4,000
-    points, metres) of the ball's deformed surface moved 0.3 mm outward: a known shape error."""
+    points, metres) of the ball's deformed outer surface (mid-surface + t/2 = 1.25 mm) moved
+    0.3 mm further outward: a known shape error at the default (outer-surface) offset."""
     import trimesh
 
     from graspdef.geometry import TriMesh
     from graspdef.scans import Scanner, scan_surface, write_scan
 
     m = trimesh.load(ball_run / "deformed.ply", process=False)
-    v = np.asarray(m.vertices) * 1e-3
+    v = np.asarray(m.vertices)                                   # run folders are SI (metres)
     n = v - v.mean(axis=0)
-    v = v + 3e-4 * n / np.linalg.norm(n, axis=1, keepdims=True)
+    v = v + (1.25e-3 + 3e-4) * n / np.linalg.norm(n, axis=1, keepdims=True)
     scan = scan_surface(TriMesh(v, np.asarray(m.faces)), Scanner(n_points=4000), seed=3)
     return write_scan(scan, report_root / "scans" / "ball_scan.ply", units="m")
 

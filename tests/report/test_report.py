@@ -29,10 +29,11 @@ def test_page_is_self_contained_and_has_the_numbers(scored_report):
     text = (scored_report / "report.html").read_text()
     _self_contained(text)
     rec = json.loads((scored_report / "result.json").read_text())
-    assert f"{rec['max_displacement']:.4g}" in text                   # mm, from result.json
-    uz = rec["probes"]["top"]["displacement"][2]
+    md = rec["derived"]["max_displacement"]
+    assert re.search(rf"max\. displacement \[mm\]</td><td[^>]*>{md['value'] * 1e3:.4g}<", text)
+    uz = rec["probes"]["top"]["displacement"][2] * 1e3
     assert f"{uz:.4g}" in text
-    assert "units of the run" in text and "length mm" in text
+    assert "units of the run" in text and "length m" in text
     assert len(re.findall(r"<img ", text)) == 2                        # displacement + scan error
     score = json.loads((scored_report / "score" / "score.json").read_text())
     assert f"{score['prediction']['errors']['rms_mm']:.4g}" in text
@@ -51,7 +52,8 @@ def test_load_path_plots_and_default_output(cantilever_run, tmp_path):
     _self_contained(text)
     assert 'alt="load-deflection"' in text and 'alt="Newton iterations"' in text
     rec = json.loads((d / "result.json").read_text())
-    assert f"{len(rec['newton_iterations'])} / {sum(rec['newton_iterations'])}" in text
+    its = rec["convergence"]["newton_iterations"]
+    assert f"{len(its)} / {sum(its)}" in text
     assert "consistent units" in text
     assert "table-i-table" not in text                                 # no forces: no Table I
 
@@ -67,7 +69,7 @@ def test_table_i_layout_from_a_table_file(ball_run, cantilever_run, tmp_path):
     cells = [re.findall(r"<td[^>]*>(.*?)</td>", r) for r in rows]
     assert cells[0][0] == "10.63" and cells[0][1] == "2.56"            # the paper's measured value
     assert cells[1][0] == "21.48" and cells[1][1] == "11"              # the file's value
-    md = json.loads((ball_run / "result.json").read_text())["max_displacement"]
+    md = json.loads((ball_run / "result.json").read_text())["derived"]["max_displacement"]["value"] * 1e3   # mm
     assert cells[0][4] == f"{md:.3g}"                                  # linear column
     assert cells[0][5].startswith(f"{abs(md - 2.56):.3g}")             # |predicted - measured|
     assert cells[0][2] == "&ndash;"                                    # no nonlinear run given
@@ -168,7 +170,7 @@ def test_a_stopped_path_is_marked_and_gets_no_error(cantilever_run, tmp_path):
     d = tmp_path / "stopped"
     shutil.copytree(cantilever_run, d)
     rec = json.loads((d / "result.json").read_text())
-    rec.update(completed=False, stop_reason="Newton did not converge (test)", load_factor=0.5)
+    rec["convergence"].update(completed=False, stop_reason="Newton did not converge (test)", load_factor=0.5)
     (d / "result.json").write_text(json.dumps(rec))
     (tmp_path / "runs.csv").write_text("run,force_N\nstopped,10.63\n")
     text = build_report([], tmp_path / "r.html", table=tmp_path / "runs.csv").read_text()

@@ -112,7 +112,7 @@ def cantilever_run_no_path(run_root) -> Path:
 
 
 def write_synthetic_contacts(d: Path) -> None:
-    """Two fingers pinching the plate centre (mm, N): the layout graspdef.viewer.runs accepts."""
+    """Two fingers pinching the plate centre (mm, N): the layout graspdef.runs.read accepts."""
     doc = {"units": {"length": "mm", "force": "N"},
            "fingers": [{"name": "top_pad", "position": [0, 0, 6], "wxyz": [1, 0, 0, 0], "size": [8, 8, 10]},
                        {"name": "bottom_pad", "position": [0, 0, -6], "size": [8, 8, 10]}],

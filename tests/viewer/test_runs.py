@@ -9,19 +9,23 @@ import pytest
 
 from graspdef.errors import GraspdefError
 from graspdef.viewer import layers
-from graspdef.solve.pathfile import read_path_u, write_path_u
-from graspdef.viewer.runs import RunFolderError, read_run
+from graspdef.runs.pathfile import read_path_u, write_path_u
+from graspdef.runs.read import RunFolderError, read_run
 
 
 def test_linear_run_in_mm(plate_run):
     run = read_run(plate_run)
-    assert run.analysis == "linear" and run.length_unit == "mm" and run.length_scale == 1e-3
+    # the problem file is in mm; the run folder is SI and displays mm
+    assert run.analysis == "linear" and run.length_unit == "m" and run.display_unit == "mm"
     assert run.rest_vertices.shape == run.deformed_vertices.shape == (121, 3)
     assert run.faces.shape == (200, 3)
     # SI inside: the plate is 0.1 m wide; the centre moves down (load -z)
     assert np.ptp(run.rest_vertices[:, 0]) == pytest.approx(0.1, rel=0.05)
     w = run.displacements[:, 2].min()
-    assert w < 0 and -w * 1e3 == pytest.approx(run.record["max_displacement"], rel=1e-9)
+    assert w < 0 and -w == pytest.approx(run.max_displacement(), rel=1e-9)
+    md = run.record.derived["max_displacement"]
+    assert md["unit"] == "m" and md["surface"] == "mid" and not md["rigid_motion_removed"]
+    assert np.linalg.norm(run.displacements, axis=1).max() == md["value"]         # the stored field defines it
     assert run.problem_file is not None and run.path_table is None
 
 
@@ -70,7 +74,7 @@ def test_path_u_roundtrip(tmp_path):
     ("bad_json", "result.json is not valid JSON"),
     ("no_path_csv", "a nonlinear run needs path.csv"),
     ("mismatch", "do not match"),
-    ("units", "states units 'mm' but result.json says 'consistent'"),
+    ("units", "states units 'm' but result.json says 'consistent'"),
     ("bad_path_u", "path_u.npz does not match"),
     ("bad_contacts", "contacts.json: contacts\\[0\\].force must be 3 finite numbers"),
 ])
@@ -154,15 +158,3 @@ def test_grasp_pipeline_contacts_in_world_frame(plate_run, tmp_path):
         np.testing.assert_allclose(run.contacts.forces[0], f_obj, atol=1e-12)
         assert run.contacts.fingers[0]["name"] == "left"
         np.testing.assert_allclose(run.contacts.fingers[0]["position"], p_obj, atol=1e-12)
-    rec = json.loads((d / "result.json").read_text())
-    rec["units"] = "SI (m, N, Pa)"
-    (d / "result.json").write_text(json.dumps(rec))
-    for f in ("deformed.ply", "undeformed.ply"):                               # grasp runs write metres
-        from graspdef.viewer.runs import _ply
-        from graspdef.geometry.io import save_ply
-
-        v, fc, _, _ = _ply(plate_run / f, "x")
-        save_ply(d / f, v * 1e-3, fc, units="m")
-    run = read_run(d)
-    assert run.length_unit == "m" and run.force_unit == "N"
-    np.testing.assert_allclose(run.rest_vertices, read_run(plate_run).rest_vertices, atol=1e-15)

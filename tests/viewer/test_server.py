@@ -12,7 +12,7 @@ import pytest
 import viser  # noqa: F401  (the viewer extra is part of make test)
 
 from graspdef.cli import main as graspdef_main  # noqa: E402
-from graspdef.viewer.runs import RunFolderError  # noqa: E402
+from graspdef.runs.read import RunFolderError  # noqa: E402
 from graspdef.viewer.server import Viewer, ViewerError  # noqa: E402
 
 
@@ -160,7 +160,7 @@ def test_path_resolved_when_path_u_absent(cantilever_run_no_path, cantilever_run
         assert v.wait_ready(120)
         rv = v.views[0]
         assert rv.run.path_u is not None and rv.path_exact
-        from graspdef.viewer.runs import read_run
+        from graspdef.runs.read import read_run
 
         good = read_run(cantilever_run)
         for k in range(rv.n_path):

@@ -1,15 +1,19 @@
-"""Reading a run folder for the viewer (SI inside; the file's units kept for labels).
+"""The one run-folder reader: every consumer (report, viewer, score, sweep, gallery scripts) reads
+a run with :func:`read_run` (the format: docs/run-folder.md).
 
-Required: ``result.json``, ``deformed.ply`` and ``undeformed.ply`` (same vertex count and faces);
-for a nonlinear run also ``path.csv``.  Optional, used when present and skipped when absent:
+Required: ``result.json`` (a :class:`~graspdef.runs.record.RunRecord` of this schema),
+``deformed.ply`` (with the per-vertex displacement field ``ux, uy, uz``) and ``undeformed.ply``
+(same vertex count and faces); for a nonlinear run also ``path.csv``.  Optional, used when
+present and skipped when absent:
 
 * ``problem.toml`` -- rebuilds the Problem for live re-solves and for the surface along the path;
-* ``path_u.npz`` -- control-point displacements of every path point (:mod:`graspdef.solve.pathfile`);
+* ``path_u.npz`` -- control-point displacements of every path point (:mod:`graspdef.runs.pathfile`);
 * ``contacts.json`` -- grasp contacts (see :func:`read_contacts` for the accepted layout);
 * ``score.json`` with ``scan_errors.ply`` -- a scan score (``graspdef score``), in the run folder
   or in one of its sub-folders, or given explicitly.
 
-Every problem with a folder raises :class:`RunFolderError` naming the folder and the file.
+Every problem with a folder -- missing, truncated or corrupt files included -- raises
+:class:`RunFolderError` naming the folder and the file (one line, never a traceback).
 """
 from __future__ import annotations
 
@@ -24,19 +28,16 @@ import numpy as np
 import scipy.sparse as sp
 import trimesh
 
-from ..errors import GraspdefError
-from ..solve.pathfile import FILENAME as PATH_U_FILE
-from ..solve.pathfile import read_path_u
 from ..units import LENGTH_UNITS
+from .derived import displacement_field_label
+from .pathfile import FILENAME as PATH_U_FILE
+from .pathfile import read_path_u
+from .record import RunFolderError, RunRecord
 
 log = logging.getLogger(__name__)
 
 MM = 1e3
 REQUIRED = ("result.json", "deformed.ply", "undeformed.ply")
-
-
-class RunFolderError(GraspdefError):
-    """A run folder is missing, incomplete or unreadable."""
 
 
 def unit_scale(unit: str | None) -> float:
@@ -66,6 +67,8 @@ def _ply(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray | N
             units = parts[2].decode("ascii", "replace")
     if verts.size == 0 or not np.all(np.isfinite(verts)):
         raise RunFolderError(f"{where}: {path.name} has no vertices or non-finite ones")
+    if faces.size and (faces.min() < 0 or faces.max() >= len(verts)):
+        raise RunFolderError(f"{where}: {path.name} has faces naming vertices that do not exist")
     return verts, faces, raw, units
 
 
@@ -104,18 +107,14 @@ class ScanOverlay:
 
 @dataclass
 class RunData:
-    """One run folder, read (see the module docstring)."""
+    """One run folder, read (see the module docstring); SI arrays (or the run's consistent units)."""
 
     path: Path
-    name: str
-    record: dict
-    analysis: str
-    length_unit: str
-    force_unit: str
-    length_scale: float                            # metres per file length unit
+    record: RunRecord
     faces: np.ndarray                              # (m, 3)
-    rest_vertices: np.ndarray                      # (n, 3) [m] limit surface at rest
-    deformed_vertices: np.ndarray                  # (n, 3) [m] final state
+    rest_vertices: np.ndarray                      # (n, 3) limit surface at rest
+    deformed_vertices: np.ndarray                  # (n, 3) final state
+    displacements: np.ndarray                      # (n, 3) the field of derived.max_displacement
     problem_file: Path | None = None
     path_table: PathTable | None = None
     path_u: tuple[np.ndarray, np.ndarray, sp.csr_matrix] | None = None
@@ -124,46 +123,110 @@ class RunData:
     notes: list[str] = field(default_factory=list)
 
     @property
-    def displacements(self) -> np.ndarray:
-        """Final limit displacements (n, 3) [m]."""
-        return self.deformed_vertices - self.rest_vertices
+    def name(self) -> str:
+        return self.record.name
+
+    @property
+    def analysis(self) -> str:
+        return self.record.analysis
+
+    @property
+    def length_unit(self) -> str:
+        return self.record.units["length"]
+
+    @property
+    def display_unit(self) -> str:
+        """The length unit consumers display: mm for SI runs, else the consistent unit."""
+        return "consistent" if self.length_unit == "consistent" else "mm"
+
+    @property
+    def display_scale(self) -> float:
+        """Metres (run units) per display unit."""
+        return 1.0 if self.length_unit == "consistent" else 1e-3
+
+    @property
+    def force_unit(self) -> str:
+        return self.record.units.get("force", "N")
 
     @property
     def label(self) -> str:
         return f"{self.name} ({self.analysis})"
 
+    @property
+    def derived(self) -> dict:
+        return dict(self.record.derived)
+
+    @property
+    def displacement_label(self) -> str:
+        """What the stored displacement field is (the colour-bar label)."""
+        return displacement_field_label(self.record.derived)
+
+    @property
+    def outer_offset(self) -> float:
+        """Mid-surface to outer-surface distance (half the shell thickness, ``thickness_m`` of the
+        record; 0 when the record has none): what a scan of the object sees is offset by this."""
+        t = self.record.get("thickness_m")
+        return 0.5 * float(t) if isinstance(t, (int, float)) and t > 0 else 0.0
+
+    def max_displacement(self) -> float | None:
+        """``derived.max_displacement`` (SI or consistent), the one number every consumer shows."""
+        return self.record.value("max_displacement")
+
     def path_displacements(self, i: int) -> np.ndarray | None:
-        """Limit displacements (n, 3) [m] of path point ``i`` (None without path_u)."""
+        """Limit displacements (n, 3) of path point ``i`` from the rest shape (None without path_u)."""
         if self.path_u is None:
             return None
         u, _, L = self.path_u
         return L @ u[i]
 
 
-def read_path_csv(path: Path, length_scale: float, where: str) -> PathTable:
+TEXT_COLUMNS = ("kind",)
+
+
+def read_path_csv(path: Path, where: str) -> PathTable:
+    """``path.csv``: every row as long as the header, every column but ``kind`` numeric (empty =
+    not applicable), finite load factors; anything else is one :class:`RunFolderError`."""
     try:
-        with path.open(newline="") as fh:
+        with path.open(newline="", encoding="utf-8") as fh:
             rows = list(csv.reader(fh))
-    except OSError as exc:
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise RunFolderError(f"{where}: cannot read path.csv: {exc}") from None
     if len(rows) < 2 or "load_factor" not in rows[0]:
         raise RunFolderError(f"{where}: path.csv has no 'load_factor' column or no rows (incomplete run?)")
     header, body = rows[0], rows[1:]
+    for i, r in enumerate(body, start=2):
+        if len(r) != len(header):
+            raise RunFolderError(f"{where}: path.csv line {i} has {len(r)} fields, the header {len(header)} "
+                                 "(truncated or corrupt file)")
     cols: dict[str, np.ndarray] = {}
     for j, name in enumerate(header):
+        if name in TEXT_COLUMNS:
+            continue
         try:
             cols[name] = np.array([float(r[j]) if r[j] != "" else np.nan for r in body])
-        except (ValueError, IndexError):
-            continue
+        except ValueError:
+            bad = next(i for i, r in enumerate(body, start=2) if not _is_number(r[j]))
+            raise RunFolderError(f"{where}: path.csv line {bad}, column {name!r}: {body[bad - 2][j]!r} is not a "
+                                 "number") from None
+    if not np.all(np.isfinite(cols["load_factor"])):
+        raise RunFolderError(f"{where}: path.csv: load_factor must be finite on every line")
     probes: dict[str, np.ndarray] = {}
     for name in header:
         if "_ux[" in name:
             base, unit = name.split("_ux[")
             comps = [cols.get(f"{base}_u{c}[{unit}") for c in "xyz"]
             if all(c is not None for c in comps):
-                probes[base] = np.stack(comps, axis=1) * length_scale
+                probes[base] = np.stack(comps, axis=1)
     stable = [None if not np.isfinite(v) else bool(v) for v in cols.get("stable", np.full(len(body), np.nan))]
     return PathTable(cols["load_factor"], probes, stable, cols)
+
+
+def _is_number(t: str) -> bool:
+    try:
+        float(t or "nan")
+        return True
+    except ValueError:
+        return False
 
 
 def _vec(v, n: int, what: str, where: str) -> np.ndarray:
@@ -174,6 +237,14 @@ def _vec(v, n: int, what: str, where: str) -> np.ndarray:
 
 
 def read_contacts(path: Path, default_length_unit: str, where: str) -> Contacts:
+    """Read ``contacts.json`` (see :func:`_read_contacts`); a malformed file is one RunFolderError."""
+    try:
+        return _read_contacts(path, default_length_unit, where)
+    except (TypeError, ValueError, AttributeError, KeyError, IndexError) as exc:
+        raise RunFolderError(f"{where}: contacts.json is malformed: {type(exc).__name__}: {exc}") from None
+
+
+def _read_contacts(path: Path, default_length_unit: str, where: str) -> Contacts:
     """Read ``contacts.json``.
 
     Accepted layout (lengths in ``units.length``, default the run's; forces in ``units.force``,
@@ -253,6 +324,14 @@ def find_score(run_dir: Path) -> Path | None:
 
 
 def read_scan_overlay(score_dir: Path, where: str) -> ScanOverlay:
+    """See :func:`_read_scan_overlay`; a malformed score is one RunFolderError."""
+    try:
+        return _read_scan_overlay(score_dir, where)
+    except (TypeError, ValueError, AttributeError, KeyError, IndexError) as exc:
+        raise RunFolderError(f"{where}: score folder {score_dir} is malformed: {type(exc).__name__}: {exc}") from None
+
+
+def _read_scan_overlay(score_dir: Path, where: str) -> ScanOverlay:
     """A ``graspdef score`` folder: the scan (``scan_errors.ply``) moved into the prediction's
     frame with the stored registration, and its signed errors [mm]."""
     try:
@@ -282,7 +361,7 @@ def read_scan_overlay(score_dir: Path, where: str) -> ScanOverlay:
 
 def read_run(run_dir: str | PathLike, score_dir: str | PathLike | None = None) -> RunData:
     """Read a run folder (see the module docstring); raise :class:`RunFolderError` if it is
-    missing, incomplete or inconsistent."""
+    missing, incomplete, corrupt, inconsistent or of another schema."""
     d = Path(run_dir)
     where = f"run folder {d}"
     if not d.exists():
@@ -292,22 +371,16 @@ def read_run(run_dir: str | PathLike, score_dir: str | PathLike | None = None) -
     missing = [f for f in REQUIRED if not (d / f).is_file()]
     if missing:
         raise RunFolderError(f"{where} is incomplete: missing {', '.join(missing)} (write one with "
-                             "'graspdef solve PROBLEM.toml --out DIR')")
+                             "'graspdef solve PROBLEM.toml --out DIR' or 'graspdef grasp SCENE --force F --out DIR')")
     try:
-        rec = json.loads((d / "result.json").read_text())
-    except ValueError as exc:
+        doc = json.loads((d / "result.json").read_text(encoding="utf-8"))
+    except (ValueError, OSError) as exc:
         raise RunFolderError(f"{where}: result.json is not valid JSON: {exc}") from None
-    if not isinstance(rec, dict) or "units" not in rec:
-        raise RunFolderError(f"{where}: result.json has no 'units' (not a graspdef result)")
-    units = rec["units"]
-    if isinstance(units, str):                          # grasp runs: "SI (m, N, Pa)"
-        if not units.startswith("SI"):
-            raise RunFolderError(f"{where}: result.json: units {units!r} not understood")
-        units = {"length": "m", "force": "N"}
-    lu = units.get("length", "consistent")
-    fu = units.get("force", "consistent")
-    ls = unit_scale(lu)
-    dv, df, _, du = _ply(d / "deformed.ply", where)
+    rec = RunRecord.from_json(doc, where)
+    lu = rec.units["length"]
+    if lu != "consistent" and lu != "m":
+        raise RunFolderError(f"{where}: result.json: length unit {lu!r} (run folders are SI: 'm', or 'consistent')")
+    dv, df, raw, du = _ply(d / "deformed.ply", where)
     rv, rf, _, ru = _ply(d / "undeformed.ply", where)
     for fname, u in (("deformed.ply", du), ("undeformed.ply", ru)):
         if u is not None and u != lu:
@@ -317,28 +390,33 @@ def read_run(run_dir: str | PathLike, score_dir: str | PathLike | None = None) -
                              f"({len(rv)} vertices, {len(rf)} faces) do not match")
     if len(df) == 0:
         raise RunFolderError(f"{where}: deformed.ply has no faces")
-    analysis = str(rec.get("analysis", "linear"))
-    run = RunData(d, str(rec.get("name", d.name)), rec, analysis, lu, fu, ls, df, rv * ls, dv * ls)
+    if raw is None or not {"ux", "uy", "uz"} <= set(raw.dtype.names or ()):
+        raise RunFolderError(f"{where}: deformed.ply has no per-vertex displacement (ux, uy, uz)")
+    u = np.column_stack([np.asarray(raw[c], dtype=float) for c in ("ux", "uy", "uz")])
+    if u.shape != dv.shape or not np.all(np.isfinite(u)):
+        raise RunFolderError(f"{where}: deformed.ply: the displacement field is not finite on every vertex")
+    run = RunData(d, rec, df, rv, dv, u)
     if (d / "problem.toml").is_file():
         run.problem_file = d / "problem.toml"
     else:
         run.notes.append("no problem.toml: live re-solves are off")
-    if analysis == "nonlinear":
+    if rec.analysis == "nonlinear":
         if not (d / "path.csv").is_file():
             raise RunFolderError(f"{where} is incomplete: a nonlinear run needs path.csv")
-        run.path_table = read_path_csv(d / "path.csv", ls, where)
-        if rec.get("completed") is False:
-            run.notes.append(f"the load path stopped at load factor {rec.get('load_factor', float('nan')):.4g}: "
-                             f"{rec.get('stop_reason') or 'see result.json'}")
+        run.path_table = read_path_csv(d / "path.csv", where)
+        conv = rec.get("convergence") or {}
+        if conv.get("completed") is False:
+            run.notes.append(f"the load path stopped at load factor {conv.get('load_factor', float('nan')):.4g}: "
+                             f"{conv.get('stop_reason') or 'see result.json'}")
         if (d / PATH_U_FILE).is_file():
             try:
-                u, lf, L = read_path_u(d / PATH_U_FILE)
-            except (ValueError, OSError, KeyError) as exc:
-                raise RunFolderError(f"{where}: {PATH_U_FILE}: {exc}") from None
+                pu, lf, L = read_path_u(d / PATH_U_FILE)
+            except Exception as exc:  # numpy/zipfile raise many types for a corrupt archive
+                raise RunFolderError(f"{where}: {PATH_U_FILE} is unreadable: {type(exc).__name__}: {exc}") from None
             if L.shape[0] != len(rv) or len(lf) != len(run.path_table.load_factors) or \
                     not np.allclose(lf, run.path_table.load_factors, rtol=1e-9, atol=1e-12):
                 raise RunFolderError(f"{where}: {PATH_U_FILE} does not match path.csv / the surface")
-            run.path_u = (u, lf, L)
+            run.path_u = (pu, lf, L)
     if (d / "contacts.json").is_file():
         run.contacts = read_contacts(d / "contacts.json", lu, where)
     sd = Path(score_dir) if score_dir is not None else find_score(d)

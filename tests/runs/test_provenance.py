@@ -2,7 +2,7 @@
 import json
 
 from graspdef.cli import main
-from graspdef.geometry.provenance import provenance_record, read_provenance, write_provenance
+from graspdef.runs.provenance import provenance_record, read_provenance, write_provenance
 
 PLATE = """
 name = "tiny_plate"
@@ -54,4 +54,4 @@ def test_solve_run_folder_reproducible_from_itself(tmp_path, capsys):
     assert (tmp_path / "a" / "problem.toml").read_text() == PLATE
     assert main(["-q", "solve", str(tmp_path / "a" / "problem.toml"), "--out", str(tmp_path / "b")]) == 0
     ra, rb = (json.loads((tmp_path / d / "result.json").read_text()) for d in "ab")
-    assert ra["max_displacement"] == rb["max_displacement"]
+    assert ra["derived"]["max_displacement"] == rb["derived"]["max_displacement"]

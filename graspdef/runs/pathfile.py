@@ -2,7 +2,7 @@
 
 A run folder's ``path.csv`` holds one row per converged point, but only probe displacements; this
 optional file adds the full state so that a viewer can show the surface at every step without
-re-solving.  It depends on numpy and scipy only (so it can live in ``graspdef.solve`` unchanged).
+re-solving.  It depends on numpy and scipy only.
 
 Keys (SI, metres):
 
@@ -45,11 +45,6 @@ def write_path_u(run_dir: str | PathLike, u: np.ndarray, load_factors: np.ndarra
     np.savez_compressed(path, u=u, load_factors=lf, limit_data=L.data, limit_indices=L.indices,
                         limit_indptr=L.indptr, limit_shape=np.array(L.shape), format=np.array(FORMAT))
     return path
-
-
-def write_solution_path(run_dir: str | PathLike, sol) -> Path:
-    """Write ``path_u.npz`` for a ``NonlinearSolution`` (the one-line hook of a run writer)."""
-    return write_path_u(run_dir, np.stack([p.u for p in sol.path]), sol.load_factors(), sol.limit_map())
 
 
 def read_path_u(path: str | PathLike) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix]:

@@ -1,14 +1,14 @@
 """``provenance.json``: what a run folder was made with, so it can be reproduced from the folder.
 
 Every run-folder writer (``graspdef solve``, ``score``, ``grasp``, ``sweep`` and ``bench --out``)
-calls :func:`write_provenance` inside its :func:`graspdef.geometry.io.atomic_folder` block.  The
+calls :func:`write_provenance` inside its :func:`graspdef.runs.folder.atomic_folder` block.  The
 record holds the exact configuration the writer was given (a JSON-ready dict: the problem file's
 text, the grasp options, the sweep spec, ...), the command line, the UTC time, the host, the
 graspdef version and git commit (with a ``dirty`` flag when the working tree differs from it),
 and the versions of Python and of the numerical packages the run used.
 
-It lives in the geometry layer, next to ``atomic_folder``, because every writer above may import
-it; it imports nothing of graspdef's and never imports a package itself (optional packages are
+It lives in the run package (the lowest layer above geometry), next to ``atomic_folder``, because
+every writer above may import it; it imports nothing of graspdef's and never imports a package itself (optional packages are
 reported only when the process has already imported them).
 """
 from __future__ import annotations
