@@ -14,6 +14,8 @@ PKG = Path(__file__).resolve().parents[1] / "graspdef"
 LAYERS = ["errors", "units", "runtime", "config", "testing", "geometry", "runs", "subdivision", "shell", "axisym",
           "problem", "solve", "contact", "sim", "scans", "registration", "objects", "viewer", "report", "pipeline",
           "sweep", "bench", "cli"]
+#: sibling rooms that must not import each other (ARCHITECTURE.md: "viewer | report")
+SIBLINGS = [("viewer", "report")]
 HEAVY = {"mujoco", "open3d", "viser"}
 #: layers below "bench" that may import a heavy package (lazily), by package
 HEAVY_ALLOWED = {"open3d": {"scans", "registration"}, "mujoco": {"sim"}, "viser": {"viewer"}}
@@ -24,21 +26,24 @@ def _layer(module: str) -> int:
     return LAYERS.index(top)
 
 
-def _imports(path: Path) -> list[str]:
-    tree = ast.parse(path.read_text())
+def _resolve(path: Path, node: ast.ImportFrom) -> str:
+    """The absolute module name of a ``from ... import`` in ``path``."""
     rel = path.relative_to(PKG.parent).with_suffix("")
     package = ".".join(rel.parts[:-1]) if rel.name != "__init__" else ".".join(rel.parts)
+    if node.level:
+        base = package.split(".")[: len(package.split(".")) - node.level + 1]
+        return ".".join(base + ([node.module] if node.module else []))
+    return node.module or ""
+
+
+def _imports(path: Path) -> list[str]:
+    tree = ast.parse(path.read_text())
     out = []
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             out += [a.name for a in node.names]
         elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")[: len(package.split(".")) - node.level + 1]
-                mod = ".".join(base + ([node.module] if node.module else []))
-            else:
-                mod = node.module or ""
-            out.append(mod)
+            out.append(_resolve(path, node))
     return out
 
 
@@ -57,6 +62,65 @@ def test_imports_point_down(path):
             if mod == "graspdef":
                 continue
             assert _layer(mod) <= own, f"{rel} (layer {LAYERS[own]}) imports {mod} from a higher layer"
+
+
+def _room(rel: Path) -> str:
+    return rel.parts[0][:-3] if len(rel.parts) == 1 else rel.parts[0]
+
+
+@pytest.mark.parametrize("path", MODULES, ids=[str(p.relative_to(PKG)) for p in MODULES])
+def test_siblings_do_not_import_each_other(path):
+    """report does not import viewer, nor viewer report: both read runs through graspdef.runs."""
+    room = _room(path.relative_to(PKG))
+    for a, b in SIBLINGS:
+        other = {a: b, b: a}.get(room)
+        if other is None:
+            continue
+        for mod in _imports(path):
+            assert not mod.startswith(f"graspdef.{other}"), f"{path.relative_to(PKG)} imports {mod} (sibling)"
+
+
+#: private members of *third-party* objects a module needs (not graspdef's rooms): pypardiso has no
+#: public API for PARDISO's phases (analysis once, factorisation per step; ../shared/MEASURED.md),
+#: nor for the MKL library it loaded (the sweep records which one its workers use)
+THIRD_PARTY_PRIVATE = {"solve/sparse.py": {"_check_A", "_call_pardiso"}, "sweep/run.py": {"_name"}}
+
+
+def _defined_private_names(tree) -> set:
+    """Underscore names a module defines itself: functions, classes, attributes it assigns."""
+    out = set()
+    for n in ast.walk(tree):
+        if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            out.add(n.name)
+        elif isinstance(n, ast.Attribute) and isinstance(n.ctx, ast.Store):
+            out.add(n.attr)
+        elif isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store):
+            out.add(n.id)
+    return {x for x in out if x.startswith("_") and not x.startswith("__")}
+
+
+@pytest.mark.parametrize("path", MODULES, ids=[str(p.relative_to(PKG)) for p in MODULES])
+def test_no_private_members_of_other_rooms(path):
+    """No module imports an underscore name from another room, or reads a private member
+    (``obj._name``) that its own module does not define: what a room offers another is its public
+    API (e.g. the pipeline uses the path solver's public methods, the solver reads the enclosed
+    gas through ``record``, not its private volume)."""
+    rel = path.relative_to(PKG)
+    room = _room(rel)
+    tree = ast.parse(path.read_text())
+    own = _defined_private_names(tree)
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            mod = _resolve(path, node)
+            for a in node.names:
+                if a.name.startswith("_") and not a.name.startswith("__") and mod.startswith("graspdef."):
+                    assert mod.split(".")[1] == room, f"{rel}:{node.lineno} imports the private {a.name} from {mod}"
+        if isinstance(node, ast.Attribute) and node.attr.startswith("_") and not node.attr.startswith("__"):
+            if isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"):
+                continue
+            if node.attr in THIRD_PARTY_PRIVATE.get(str(rel), ()):
+                continue
+            assert node.attr in own, f"{rel}:{node.lineno} reads the private member {ast.unparse(node)}"
 
 
 @pytest.mark.parametrize("path", MODULES, ids=[str(p.relative_to(PKG)) for p in MODULES])

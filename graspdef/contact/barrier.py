@@ -36,13 +36,15 @@ not.)  The generalised load of the load factor is -d(grad Pi)/d lam = -B_xs F_ta
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..errors import ProblemError
-from ..problem.potentials import PotentialTerms
+from ..problem.terms import TermBase
+from ..problem.terms import TermValue as PotentialTerms
 
 
 class _NoPosition(ProblemError):
@@ -185,7 +187,7 @@ def _samples(shell, ev, faces: np.ndarray, L: int):
 
 
 @dataclass
-class FingerContact:
+class FingerContact(TermBase):
     """A force-controlled rigid fingertip against the shell (see the module docstring).
 
     Parameters
@@ -217,7 +219,11 @@ class FingerContact:
     name: str = "finger"
 
     # ---- set-up ------------------------------------------------------------------------------
-    def bind(self, shell, ev) -> "FingerContact":
+    def build(self, shell, ev) -> "FingerContact":
+        """A ready contact term on ``shell`` (a new object; this specification is unchanged)."""
+        return copy.copy(self)._setup(shell, ev)
+
+    def _setup(self, shell, ev) -> "FingerContact":
         e = np.asarray(self.axis, float)
         if e.shape != (3,) or not np.all(np.isfinite(e)) or np.linalg.norm(e) == 0:
             raise ProblemError(f"finger contact '{self.name}': axis must be a non-zero 3-vector, got {self.axis!r}")
@@ -418,7 +424,7 @@ class FingerContact:
                            shape=(3 * self._n, 3 * self._n))
         return s, value, grad.ravel(), Hm, Bss, v.ravel()
 
-    def evaluate(self, x: np.ndarray, lam: float, order: int = 2) -> PotentialTerms:
+    def evaluate(self, x: np.ndarray, lam: float, order: int = 2, u: np.ndarray | None = None) -> PotentialTerms:
         F = lam * self.force
         self._last = (x.copy(), F, None)
         if F <= 0:                                          # no push: the finger is retracted

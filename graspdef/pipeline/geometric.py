@@ -15,7 +15,6 @@ rest-state quadratic form 1/2 u.K0 u (the linear shell; contact is nonlinear by 
 """
 from __future__ import annotations
 
-import copy
 
 import numpy as np
 
@@ -77,35 +76,10 @@ def finger_contacts(mapping, g, targets: dict, thickness: float, dhat: float | N
     return loads, fingers
 
 
-class _RestQuadratic:
-    """The linear shell's energy 1/2 u.K0 u (K0: the shell energy's Hessian at rest), with the
-    interface of graspdef.shell.energy.ShellEnergy that the equilibrium solver calls."""
-
-    def __init__(self, K, X):
-        self.K, self.X = K.tocsr(), X
-
-    def energy(self, x):
-        u = (x - self.X).ravel()
-        return 0.5 * float(u @ (self.K @ u))
-
-    def gradient(self, x):
-        u = (x - self.X).ravel()
-        Ku = self.K @ u
-        return 0.5 * float(u @ Ku), Ku
-
-    def hessian(self, x):
-        E, g = self.gradient(x)
-        return E, g, self.K
-
-
 def solve_contact(problem, options, linear: bool):
     """The load path of a problem with finger contacts; ``linear``: the linear shell (rest-state
     stiffness) instead of the finite-deformation one.  Raises PathStopped like solve_nonlinear."""
-    ps = PathSolver(problem, options)
-    if linear:
-        eq = ps.eq
-        K = eq.energy_fn.hessian(eq.X)[2]
-        eq.energy_fn = _RestQuadratic(K, eq.X)
+    ps = PathSolver(problem, options, terms=problem.energy_terms("rest" if linear else "finite"))
     sol = ps.run()
     if not sol.completed:
         raise PathStopped(f"the load path stopped at load factor {sol.load_factor:.6g} after "
@@ -121,6 +95,6 @@ def contact_reports(shell, fingers: list, u: np.ndarray, lam: float, u_ref: np.n
     x0 = shell.rest_positions + (0.0 if u_ref is None else u_ref)
     out = {}
     for fc in fingers:
-        b = copy.copy(fc).bind(shell, shell.evaluator)
+        b = fc.build(shell, shell.evaluator)
         out[fc.name] = dict(b.report(x, lam), touch_advance_m=b.touch(x0))
     return out

@@ -11,14 +11,17 @@ points so that the tangent stays symmetric and exact.
   cross-section about a fixed axis e: potential ``-lam m int theta ds`` with theta the rotation of
   the surface tangent across the edge about e (exact for the rolling-up cantilever).
 
-``evaluate(x, lam, order)`` returns a :class:`PotentialTerms` (value, gradient, Hessian, rank-one
-parts) and ``load(x)`` the generalised force -d(value)/d(lam) that the load factor scales (zero
-for the gas).  States change branch only through ``commit(x)`` at a converged step (the edge
-rotation is tracked continuously past +-pi).
+Each is a specification; ``build(shell, evaluator)`` returns a ready energy term of it (a new
+object, :mod:`graspdef.problem.terms` protocol): ``evaluate(x, lam, order, u)`` returns a
+:class:`~graspdef.problem.terms.TermValue` (value, gradient, Hessian, rank-one parts) and
+``load(x)`` the generalised force -d(gradient)/d(lam) that the load factor scales (zero for the
+gas).  States change branch only through ``commit(x)`` at a converged step (the edge rotation is
+tracked continuously past +-pi); ``record(x)`` gives the numbers of the path record.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import copy
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -28,6 +31,7 @@ from ..errors import ProblemError
 from ..shell.model import Shell
 from ..shell.volume import EnclosedVolume
 from ..subdivision.evaluate import SurfaceEvaluator
+from .terms import TermBase, TermValue
 
 #: standard atmosphere [Pa]
 P_ATM = 101_325.0
@@ -35,15 +39,8 @@ P_ATM = 101_325.0
 _CORNERS = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
 
 
-@dataclass
-class PotentialTerms:
-    """Value [J], gradient (3n,) [N], Hessian (3n, 3n) [N/m] or None, and rank-one Hessian
-    parts [(c, v)] meaning c v v^T."""
-
-    value: float
-    gradient: np.ndarray
-    hessian: sp.csr_matrix | None
-    rank_one: list = field(default_factory=list)
+#: the value type of every term (kept under its earlier name for the potentials' callers)
+PotentialTerms = TermValue
 
 
 def _require_closed(shell: Shell, what: str) -> None:
@@ -53,13 +50,17 @@ def _require_closed(shell: Shell, what: str) -> None:
 
 
 @dataclass
-class FollowerPressure:
+class FollowerPressure(TermBase):
     """Pressure p [Pa] that follows the deformed normal of a closed surface (positive: along
     the outward normal of an outward-oriented surface, i.e. inflating)."""
 
     p: float
 
-    def bind(self, shell: Shell, ev: SurfaceEvaluator) -> "FollowerPressure":
+    def build(self, shell: Shell, ev: SurfaceEvaluator) -> "FollowerPressure":
+        """A ready term of this specification on ``shell`` (a new object; this one is unchanged)."""
+        return copy.copy(self)._setup(shell, ev)
+
+    def _setup(self, shell: Shell, ev: SurfaceEvaluator) -> "FollowerPressure":
         if not np.isfinite(self.p):
             raise ProblemError(f"follower pressure must be finite, got {self.p!r}")
         _require_closed(shell, "a follower pressure")
@@ -69,7 +70,7 @@ class FollowerPressure:
     def scaled(self) -> bool:
         return True
 
-    def evaluate(self, x: np.ndarray, lam: float, order: int = 2) -> PotentialTerms:
+    def evaluate(self, x: np.ndarray, lam: float, order: int = 2, u: np.ndarray | None = None) -> PotentialTerms:
         if order == 0:
             return PotentialTerms(-lam * self.p * self._vol.value(x), None, None)
         if order < 2:
@@ -86,14 +87,19 @@ class FollowerPressure:
 
 
 @dataclass
-class EnclosedGas:
+class EnclosedGas(TermBase):
     """Ideal gas sealed inside a closed shell at initial gauge pressure ``p0`` [Pa] (relative
     to ``p_atm`` outside), isothermal: (p_atm + p) V = (p_atm + p0) V0."""
 
     p0: float
     p_atm: float = P_ATM
+    record_name = "gas"                 # path-record columns gas<i>_volume_m3, gas<i>_gauge_pressure_Pa
 
-    def bind(self, shell: Shell, ev: SurfaceEvaluator) -> "EnclosedGas":
+    def build(self, shell: Shell, ev: SurfaceEvaluator) -> "EnclosedGas":
+        """A ready term of this specification on ``shell`` (a new object; this one is unchanged)."""
+        return copy.copy(self)._setup(shell, ev)
+
+    def _setup(self, shell: Shell, ev: SurfaceEvaluator) -> "EnclosedGas":
         if not (np.isfinite(self.p0) and np.isfinite(self.p_atm)) or self.p_atm <= 0 or self.p_atm + self.p0 <= 0:
             raise ProblemError(f"enclosed gas: need p_atm > 0 and p_atm + p0 > 0 (absolute pressure), got "
                                f"p0={self.p0!r}, p_atm={self.p_atm!r}")
@@ -117,7 +123,7 @@ class EnclosedGas:
             return np.inf
         return -(self.p_atm + self.p0) * self.V0 * np.log(V / self.V0) + self.p_atm * (V - self.V0)
 
-    def evaluate(self, x: np.ndarray, lam: float, order: int = 2) -> PotentialTerms:
+    def evaluate(self, x: np.ndarray, lam: float, order: int = 2, u: np.ndarray | None = None) -> PotentialTerms:
         if order == 0:
             return PotentialTerms(self._value(self._vol.value(x)), None, None)
         if order < 2:
@@ -132,12 +138,17 @@ class EnclosedGas:
     def load(self, x: np.ndarray) -> np.ndarray:
         return np.zeros(3 * len(x))
 
+    def record(self, x: np.ndarray) -> dict:
+        """The gas's volume [m^3] and gauge pressure [Pa] at ``x`` (for the path record)."""
+        V = self._vol.value(x)
+        return {"volume_m3": V, "gauge_pressure_Pa": self.gauge_pressure(V)}
+
     def commit(self, x: np.ndarray) -> None:
         pass
 
 
 @dataclass
-class EdgeMoment:
+class EdgeMoment(TermBase):
     """Follower couple of ``moment`` [N m per m of edge] on the boundary edges selected by
     ``where`` (both end vertices), turning the cross-section about the fixed ``axis`` (unit;
     the sense is right-handed about it).  The rotation theta at an edge point is the angle,
@@ -150,7 +161,11 @@ class EdgeMoment:
     name: str = "edge_moment"
     n_points: int = 3
 
-    def bind(self, shell: Shell, ev: SurfaceEvaluator) -> "EdgeMoment":
+    def build(self, shell: Shell, ev: SurfaceEvaluator) -> "EdgeMoment":
+        """A ready term of this specification on ``shell`` (a new object; this one is unchanged)."""
+        return copy.copy(self)._setup(shell, ev)
+
+    def _setup(self, shell: Shell, ev: SurfaceEvaluator) -> "EdgeMoment":
         if not np.isfinite(self.moment):
             raise ProblemError(f"edge moment '{self.name}': moment must be finite, got {self.moment!r}")
         e = np.asarray(self.axis, float)
@@ -230,7 +245,7 @@ class EdgeMoment:
         np.add.at(out, self._st, self._d[:, :, None] * per_point[:, None, :])
         return out.ravel()
 
-    def evaluate(self, x: np.ndarray, lam: float, order: int = 2) -> PotentialTerms:
+    def evaluate(self, x: np.ndarray, lam: float, order: int = 2, u: np.ndarray | None = None) -> PotentialTerms:
         c = -lam * self.moment * self._w                    # potential = sum c_k theta_k
         theta = self.angles(x)
         _, tp, r2, u, g = self._derivs(x)
@@ -263,7 +278,7 @@ Potential = FollowerPressure | EnclosedGas | EdgeMoment
 
 
 def is_potential(load) -> bool:
-    """The three potentials above, or any object with their interface (bind, scaled, evaluate,
-    load, commit), e.g. a contact potential of a higher layer (graspdef.contact.FingerContact)."""
+    """The three potentials above, or any specification with their interface (build, evaluate,
+    load, commit), e.g. a contact term of a higher layer (graspdef.contact.FingerContact)."""
     return isinstance(load, (FollowerPressure, EnclosedGas, EdgeMoment)) or all(
-        callable(getattr(load, m, None)) for m in ("bind", "scaled", "evaluate", "load", "commit"))
+        callable(getattr(load, m, None)) for m in ("build", "evaluate", "load", "commit"))

@@ -1,7 +1,6 @@
 """The Problem: a shell with loads, supports and named probe points; what every solver receives."""
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -13,6 +12,7 @@ from ..subdivision.evaluate import SurfaceEvaluator, project_point
 from .loads import PointLoad, load_vector
 from .potentials import EnclosedGas, is_potential
 from .nitsche import NitscheRotation
+from .terms import DeadLoads, NitscheTerm, RestQuadratic, ShellElastic
 from .supports import RigidModes, check_rigid_modes, constraint_rows, independent_rows, three_point_supports
 
 
@@ -93,8 +93,22 @@ class Problem:
         return load_vector(self.shell, [ld for ld in self.loads if not is_potential(ld)], self.evaluator)
 
     def potentials(self) -> list:
-        """The configuration-dependent loads, bound to this shell with fresh state."""
-        return [copy.copy(ld).bind(self.shell, self.evaluator) for ld in self.loads if is_potential(ld)]
+        """The configuration-dependent loads as ready energy terms on this shell (fresh state)."""
+        return [ld.build(self.shell, self.evaluator) for ld in self.loads if is_potential(ld)]
+
+    def energy_terms(self, elastic: str = "finite") -> list:
+        """The total potential of the nonlinear solver as a list of energy terms
+        (:mod:`graspdef.problem.terms`), in the order they are summed: the shell's elastic energy
+        (``elastic``: "finite" deformation, or "rest": the linear shell's quadratic energy), the
+        Nitsche terms of rotation-fixed edges, the dead loads, the configuration-dependent loads."""
+        if elastic not in ("finite", "rest"):
+            raise ProblemError(f"elastic must be 'finite' or 'rest', got {elastic!r}")
+        terms = [ShellElastic(self.shell) if elastic == "finite" else RestQuadratic(self.shell)]
+        nitsche = NitscheRotation(self.shell, self.supports, self.evaluator)
+        if nitsche:
+            terms.append(NitscheTerm(nitsche))
+        terms.append(DeadLoads(self.dead_load_vector(), self.shell.rest_positions))
+        return terms + self.potentials()
 
     def load_vector(self) -> np.ndarray:
         """External force vector of linear theory (3 n_control,) [N]: the dead loads plus the

@@ -150,13 +150,9 @@ class BlockPattern:
 
 
 def block_pattern(shell: Shell) -> BlockPattern:
-    """The shell's :class:`BlockPattern`, built once per (immutable) shell and kept with it, so
-    that the energy, the enclosed volume and the other terms of one problem share it."""
-    pat = shell.__dict__.get("_block_pattern")
-    if pat is None:
-        pat = BlockPattern(shell)
-        shell.__dict__["_block_pattern"] = pat
-    return pat
+    """The shell's :class:`BlockPattern` (``Shell.block_pattern``: built once per immutable shell,
+    shared by the energy, the enclosed volume and the other terms of one problem)."""
+    return shell.block_pattern
 
 
 class ShellEnergy:

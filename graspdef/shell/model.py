@@ -1,6 +1,8 @@
 """A shell: ghosted control mesh + Loop basis + material + thickness, with rest quantities."""
 from __future__ import annotations
 
+import functools
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -92,14 +94,19 @@ class Shell:
     def n_control(self) -> int:
         return self.mesh.n_control
 
-    @property
+    @functools.cached_property
     def evaluator(self) -> SurfaceEvaluator:
-        """Limit-surface evaluation at any (face, point) of this shell's control mesh (cached)."""
-        ev = self.__dict__.get("_evaluator")
-        if ev is None:
-            ev = SurfaceEvaluator(self.mesh.faces, self.mesh.n_control)
-            object.__setattr__(self, "_evaluator", ev)
-        return ev
+        """Limit-surface evaluation at any (face, point) of this shell's control mesh (built on
+        first use and kept: a derived, immutable property of the immutable shell)."""
+        return SurfaceEvaluator(self.mesh.faces, self.mesh.n_control)
+
+    @functools.cached_property
+    def block_pattern(self):
+        """The sparsity pattern of the shell's Hessian blocks (graspdef.shell.energy.BlockPattern),
+        built on first use and shared by the energy, the enclosed volume and the other terms."""
+        from .energy import BlockPattern
+
+        return BlockPattern(self)
 
     @property
     def n_dofs(self) -> int:

@@ -1,15 +1,18 @@
 """The discrete equilibrium problem of the nonlinear solvers.
 
-Total potential energy of the control points x = X + u at load factor lam::
+Total potential energy of the control points x = X + u at load factor lam: the sum of a list of
+energy terms (:mod:`graspdef.problem.terms`; :meth:`Problem.energy_terms` builds them)::
 
-    Pi(x, lam) = E(x) + Pi_N(x) - lam f.u + sum_i Pi_i(x, lam)
+    Pi(x, lam) = sum_i Pi_i(x, lam)
 
-with the shell's elastic energy E, the Nitsche rotation terms Pi_N of clamped/symmetry edges
-(``graspdef.problem.nitsche``: consistent at finite deformation), the dead loads f and the
-configuration-dependent loads Pi_i (``graspdef.problem.potentials``).  Supports are the linear
+-- typically the shell's elastic energy, the Nitsche rotation terms of clamped/symmetry edges
+(``graspdef.problem.nitsche``: consistent at finite deformation), the dead loads -lam f.u and
+the configuration-dependent loads (``graspdef.problem.potentials``, finger contact).  The sum
+knows no term by name.  Supports are the linear
 constraints C u = lam g (g non-zero for prescribed displacements); rigid-body modes of a free
 body are removed by a statically determinate 3-2-1 point support (exact at finite rotation).  The load direction is
-q(x) = -d(grad Pi)/d lam = f + sum_i load_i(x).
+q(x) = -d(grad Pi)/d lam = sum_i load_i(x); the force scale of the convergence test is the
+gradient of the internal terms (the shell's own elastic and support forces).
 
 Each linearised step solves the KKT system of the Hessian H (+ rank-one parts, by the Woodbury
 identity) and reports its inertia: the equilibrium is stable when the KKT matrix has exactly
@@ -24,9 +27,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import SolverError
-from ..problem.nitsche import NitscheRotation
 from ..problem.problem import Problem
-from ..shell.energy import ShellEnergy
+from ..problem.terms import EnergyTerm
 from .sparse import KKTSystem, same_array
 
 
@@ -56,15 +58,13 @@ class State:
 class Equilibrium:
     """Energy, residual and tangent solves of a :class:`Problem` (see the module docstring)."""
 
-    def __init__(self, problem: Problem, backend: str = "auto"):
+    def __init__(self, problem: Problem, backend: str = "auto", terms: list[EnergyTerm] | None = None):
+        """``terms``: the energy terms to sum (default ``problem.energy_terms()``)."""
         self.problem = problem
         shell = problem.shell
         self.X = shell.rest_positions.copy()
         self.n = shell.n_dofs
-        self.energy_fn = ShellEnergy(shell)
-        self.nitsche = NitscheRotation(shell, problem.supports, problem.evaluator)
-        self.f = problem.dead_load_vector()
-        self.potentials = problem.potentials()
+        self.terms = list(problem.energy_terms() if terms is None else terms)
         self.C, self.labels, self.g = problem.constraints(with_targets=True, rigid="three_point")
         self.m = self.C.shape[0]
         self.kkt = KKTSystem(self.C, backend)
@@ -76,50 +76,42 @@ class Equilibrium:
 
     # ---- energy and derivatives -------------------------------------------------------------
     def evaluate(self, u: np.ndarray, lam: float, order: int = 2) -> State:
-        """Pi, grad Pi, Hessian (order 2) and q at displacement u (3n,) and load factor lam."""
+        """Pi, grad Pi, Hessian (order 2) and q at displacement u (3n,) and load factor lam: the
+        sums over the terms, in their order."""
         x = self.X + u.reshape(-1, 3)
-        if order == 0:
-            E = self.energy_fn.energy(x)
-            grad = None
-        elif order == 1:
-            E, grad = self.energy_fn.gradient(x)
-            H = None
-        else:
-            E, grad, H = self.energy_fn.hessian(x)
-        if self.nitsche:
-            en, gn, Hn = self.nitsche.evaluate(x, order=max(order, 1))
-            E += en
-        E -= lam * float(self.f @ u)
+        E = None
+        grad = H = internal = None
         rank_one: list = []
-        q = self.f.copy()
-        internal = None
-        if order >= 1:
-            if self.nitsche:
-                grad = grad + gn
-            internal = grad
-            grad = grad - lam * self.f
-            if order == 2 and self.nitsche:
-                H = _add(H, Hn)
-        for pot in self.potentials:
-            t = pot.evaluate(x, lam, order=order)
-            E += t.value
+        q = np.zeros(self.n)
+        for t in self.terms:
+            v = t.evaluate(x, lam, order, u)
+            E = v.value if E is None else E + v.value
             if order >= 1:
-                grad = grad + t.gradient
-                q = q + pot.load(x)
+                grad = v.gradient if grad is None else grad + v.gradient
+                if t.internal:
+                    internal = grad
+                load = t.load(x)
+                if load is not None:
+                    q = q + load
             if order == 2:
-                if t.hessian is not None:
-                    H = _add(H, t.hessian)
-                rank_one += t.rank_one
+                if v.hessian is not None:
+                    H = v.hessian if H is None else _add(H, v.hessian)
+                rank_one += v.rank_one
         return State(float(E), grad, H if order == 2 else None, rank_one, q, internal)
 
     def energy(self, u: np.ndarray, lam: float) -> float:
         return self.evaluate(u, lam, order=0).energy
 
     def commit(self, u: np.ndarray) -> None:
-        """Tell the state-tracking loads (edge rotations) that ``u`` is converged."""
+        """Tell the state-tracking terms (edge rotations) that ``u`` is converged."""
         x = self.X + u.reshape(-1, 3)
-        for pot in self.potentials:
-            pot.commit(x)
+        for t in self.terms:
+            t.commit(x)
+
+    def records(self, u: np.ndarray) -> list[tuple[EnergyTerm, dict]]:
+        """Each term with its numbers for the path record (terms with none left out)."""
+        x = self.X + u.reshape(-1, 3)
+        return [(t, r) for t in self.terms if (r := t.record(x))]
 
     # ---- residuals ----------------------------------------------------------------------------
     def projected_residual(self, grad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -195,12 +195,14 @@ class PathSolver:
     """Runs one path (see the module docstring); use :func:`solve_nonlinear`."""
 
     def __init__(self, problem: Problem, options: PathOptions, backend: str = "auto",
-                 progress: Callable[[dict], None] | None = None):
+                 progress: Callable[[dict], None] | None = None, terms: list | None = None):
+        """``terms``: the energy terms to follow (default ``problem.energy_terms()``; e.g.
+        ``problem.energy_terms("rest")`` for the linear shell with contact)."""
         self.problem = problem
         self.opt = options
         self.progress = progress
-        self.eq = Equilibrium(problem, backend)
-        self.gas = [p for p in self.eq.potentials if isinstance(p, EnclosedGas)]
+        self.eq = Equilibrium(problem, backend, terms)
+        self.gas = [t for t in self.eq.terms if isinstance(t, EnclosedGas)]   # pre-loaded at lam = 0
         self.q_norm = 0.0
         self.inertia_residual = 0.0
 
@@ -218,10 +220,12 @@ class PathSolver:
         for name, sp_ in self.problem.probes.items():
             st, w = ev.values(sp_.face, np.asarray(sp_.bary))
             pt.probes[name] = w @ x_u[st]
-        for i, gas in enumerate(self.gas):
-            V = gas._vol.value(self.eq.X + x_u)
-            pt.extra[f"gas{i}_volume_m3"] = V
-            pt.extra[f"gas{i}_gauge_pressure_Pa"] = gas.gauge_pressure(V)
+        counts: dict[str, int] = {}
+        for term, rec in self.eq.records(u):          # e.g. gas0_volume_m3, gas0_gauge_pressure_Pa
+            name = getattr(term, "record_name", type(term).__name__.lower())
+            i = counts[name] = counts.get(name, -1) + 1
+            for k, v in rec.items():
+                pt.extra[f"{name}{i}_{k}"] = v
         return pt
 
     def _converged(self, state, u, lam) -> tuple[bool, float]:

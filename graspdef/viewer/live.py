@@ -80,7 +80,7 @@ class LiveModel:
             self.solver = PathSolver(self.problem, PathOptions(method="load", max_iterations=max_iterations,
                                                                tol=opts.tol, line_search=True), backend)
             eq = self.solver.eq
-            self.modulus_ok = not (eq.m and np.any(eq.g)) and not any(isinstance(p, EnclosedGas) for p in eq.potentials)
+            self.modulus_ok = not (eq.m and np.any(eq.g)) and not any(isinstance(t, EnclosedGas) for t in eq.terms)
             self.lam_end = float((run.record.get("convergence") or {}).get("load_factor", opts.max_load))
             self.u = None                                  # (3 n_control,) current converged state
             self.lam = None

@@ -85,7 +85,7 @@ def test_obstacle_distance_derivatives(obstacle):
 def test_contact_potential_derivatives(shell, obstacle):
     """Value -> gradient -> Hessian (sparse B_xx plus the rank-one -B_xs B_xs^T / B_ss of the
     eliminated finger advance) -> load (-d grad / d lam), all by central differences."""
-    fc = FingerContact(obstacle, (-1.0, 0, 0), 4.0, offset=T / 2).bind(shell, shell.evaluator)
+    fc = FingerContact(obstacle, (-1.0, 0, 0), 4.0, offset=T / 2).build(shell, shell.evaluator)
     rng = np.random.default_rng(0)
     x = shell.rest_positions + rng.normal(size=shell.rest_positions.shape) * 2e-5
     lam = 0.7
@@ -129,7 +129,7 @@ def test_pads_squeeze_force_matched_no_penetration_area_grows(shell):
     areas = []
     for lam in (0.25, 0.5, 1.0):
         x = shell.rest_positions + sol.at(lam).u
-        reps = [fc.bind(shell, shell.evaluator).report(x, lam) for fc in fingers]
+        reps = [fc.build(shell, shell.evaluator).report(x, lam) for fc in fingers]
         for r in reps:
             assert r["contact_force_along_axis_N"] == pytest.approx(lam * F, rel=1e-9)
             assert r["min_gap_m"] > 0 and r["min_gap_fine_m"] > 0
