@@ -47,6 +47,16 @@ from ..problem.terms import TermBase
 from ..problem.terms import TermValue as PotentialTerms
 
 
+#: Newton settings of load paths with finger contact (graspdef.solve.nonlinear.PathOptions fields).
+#: Contact paths take a few more Newton iterations per step (the barrier stiffens as the patch
+#: grows): let the step grow unless a step took more than 8; and they pass close to bifurcations (a
+#: ball between two pins may roll), where the branch a load-controlled path follows depends on its
+#: steps: refresh a stale tangent at contraction worse than 1/2 and factorise every converged point
+#: (the settings the contact tables were made with; the solver's defaults for smooth paths,
+#: reuse_ratio 0.9 and inertia_rtol 1e-4, stop the pinned ball at 12.9 of 20.37 N).
+CONTACT_PATH = {"desired_iterations": 8, "reuse_ratio": 0.5, "inertia_rtol": 0.0}
+
+
 class _NoPosition(ProblemError):
     """No finger advance balances the force for this configuration (a sample point went
     through the fingertip): the potential is +inf there."""

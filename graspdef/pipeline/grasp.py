@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..contact.barrier import CONTACT_PATH
 from ..contact.mapping import map_contacts
 from ..errors import ProblemError
 from ..objects import build_shell, load_object, scene_xml
@@ -200,16 +201,8 @@ def shell_problem(obj: GraspObject, st: Settled, contact: str = "point") -> Shel
 
 def solve_shell(setup: ShellSetup, analysis: str, steps: int) -> Solved:
     """Stage 4: linear or nonlinear solve; a path that stops is returned as far as it got."""
-    # contact paths take a few more Newton iterations per step (the barrier stiffens as the patch
-    # grows): let the step grow unless a step took more than 8; and they pass close to
-    # bifurcations (a ball between two pins may roll), where the branch a load-controlled path
-    # follows depends on its steps: refresh a stale tangent at contraction worse than 1/2 and
-    # factorise every converged point (the settings the contact tables were made with; the
-    # solver's defaults for smooth paths, reuse_ratio 0.9 and inertia_rtol 1e-4, stop the pinned
-    # ball at 12.9 of 20.37 N)
     fingertips = setup.fingertips
-    path_opts = {"desired_iterations": 8, "reuse_ratio": 0.5, "inertia_rtol": 0.0} if fingertips else {}
-    opt = PathOptions(steps=steps, max_steps=40 * steps, min_step=1e-3, **path_opts)
+    opt = PathOptions(steps=steps, max_steps=40 * steps, min_step=1e-3, **(CONTACT_PATH if fingertips else {}))
     if analysis == "linear" and not fingertips:
         return Solved(solve_linear(setup.problem), True, None)
     from .geometric import solve_contact
