@@ -42,7 +42,7 @@ def run(a: argparse.Namespace) -> int:
     model = "point loads" if r["contact"] == "point" else "geometric contact"
     area = f", {d['contact_area']['label']} {d['contact_area']['value'] * 1e6:.1f} mm^2" if "contact_area" in d else ""
     print(f"{r['object']}: {r['analysis']} shell, {model}, {r['force_N']:g} N per finger: {ind['label']} "
-          f"{ind['value'] * 1e3:.2f} mm{' per finger' if 'indentation_per_finger' in d else ''}, "
+          f"{ind['value'] * 1e3:.2f} mm, "
           f"{d['max_displacement']['label']} {d['max_displacement']['value'] * 1e3:.2f} mm{area}{stop}; "
           f"{r['timings_s']['total']:.1f} s")
     print(f"run folder: {run.out}")

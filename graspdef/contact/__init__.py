@@ -2,9 +2,9 @@
 the shell as point loads that keep the total force and moment exactly (graspdef.contact.mapping),
 or the fingertips as rigid, force-controlled, penetration-free obstacles (graspdef.contact.barrier).
 Never imports mujoco (graspdef.sim produces the records)."""
-from .barrier import Capsule as Capsule
+from .obstacles import Capsule as Capsule
 from .barrier import FingerContact as FingerContact
-from .barrier import RoundedBox as RoundedBox
+from .obstacles import RoundedBox as RoundedBox
 from .mapping import LoadMapping as LoadMapping
 from .mapping import map_contacts as map_contacts
 from .records import ContactSet as ContactSet

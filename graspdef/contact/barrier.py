@@ -44,6 +44,8 @@ import scipy.sparse as sp
 
 from ..errors import ProblemError
 from ..problem.terms import TermBase
+from .obstacles import Capsule, RoundedBox  # noqa: F401  (the fingertip shapes, used with FingerContact)
+from .sampling import sample_faces
 from ..problem.terms import TermValue as PotentialTerms
 
 
@@ -80,120 +82,6 @@ def log_barrier(d: np.ndarray, dhat: float) -> tuple[np.ndarray, np.ndarray, np.
     b2[act] = -2 * lg - 4 * r / x + r * r / (x * x)
     b[d <= 0] = np.inf
     return b, b1, b2
-
-
-# ---------------------------------------------------------------------------------------------
-# obstacles: distance phi(p) >= 0 outside, with gradient and Hessian (valid outside)
-@dataclass(frozen=True)
-class Capsule:
-    """A capsule (a pin): segment a-b [m] with ``radius`` [m].  Object-frame coordinates."""
-
-    a: tuple
-    b: tuple
-    radius: float
-
-    def inflated(self, r: float) -> "Capsule":
-        return Capsule(self.a, self.b, self.radius + r)
-
-    @property
-    def feature_radius(self) -> float:
-        return self.radius
-
-    def reach(self) -> float:
-        """Lateral extent about the closing axis [m]."""
-        return self.radius
-
-    def distance(self, p: np.ndarray, hessian: bool = True):
-        """phi (k,), grad (k, 3) and (``hessian``) Hessian (k, 3, 3) of the distance to the
-        capsule surface at points p (k, 3) outside it."""
-        a, b = np.asarray(self.a, float), np.asarray(self.b, float)
-        ab = b - a
-        L2 = ab @ ab
-        t = np.clip(((p - a) @ ab) / L2, 0.0, 1.0)
-        v = p - (a + t[:, None] * ab)
-        r = np.maximum(np.sqrt(np.einsum("ki,ki->k", v, v)), 1e-300)
-        n = v / r[:, None]
-        if not hessian:
-            return r - self.radius, n
-        P = np.eye(3)[None] - n[:, :, None] * n[:, None, :]
-        side = (t > 0) & (t < 1)                                # distance to the axis line
-        if side.any():
-            u = ab / np.sqrt(L2)
-            P[side] -= np.outer(u, u)[None]
-        return r - self.radius, n, P / r[:, None, None]
-
-
-@dataclass(frozen=True)
-class RoundedBox:
-    """A box with rounded edges (a pad): centre [m], rotation (3, 3) whose columns are the box
-    axes in the object frame, half extents [m] of the full box, edge radius ``rounding`` [m]."""
-
-    center: tuple
-    rotation: tuple
-    half_extents: tuple
-    rounding: float
-
-    def inflated(self, r: float) -> "RoundedBox":
-        return RoundedBox(self.center, self.rotation, tuple(h + r for h in self.half_extents), self.rounding + r)
-
-    @property
-    def feature_radius(self) -> float:
-        return self.rounding
-
-    def reach(self) -> float:
-        h = np.sort(np.asarray(self.half_extents, float))
-        return float(np.hypot(h[1], h[2]))
-
-    def distance(self, p: np.ndarray, hessian: bool = True):
-        """phi (k,), grad (k, 3) and (``hessian``) Hessian (k, 3, 3) of the distance to the
-        rounded box's surface at points p (k, 3) outside it."""
-        R = np.asarray(self.rotation, float)
-        c = np.asarray(self.center, float)
-        h = np.asarray(self.half_extents, float) - self.rounding        # inner box
-        loc = (p - c) @ R
-        s = np.where(loc < 0, -1.0, 1.0)
-        q = np.abs(loc) - h
-        m = np.maximum(q, 0.0)
-        r = np.sqrt(np.einsum("ki,ki->k", m, m))
-        inside = r <= 0
-        r = np.maximum(r, 1e-300)
-        nl = s * m / r[:, None]
-        phi = np.where(inside, q.max(axis=1), r) - self.rounding
-        n = nl @ R.T
-        if not hessian:
-            return phi, n
-        D = (q > 0).astype(float)
-        Hl = (D[:, :, None] * np.eye(3)[None] - nl[:, :, None] * nl[:, None, :]) / r[:, None, None]
-        return phi, n, R[None] @ Hl @ R.T[None]
-
-
-# ---------------------------------------------------------------------------------------------
-def _samples(shell, ev, faces: np.ndarray, L: int):
-    """Sub-triangle centroids of ``faces`` (L x L per face): stencils (F, S), N (F, q, S) and
-    rest weights (F, q) [m^2]; S padded with zero weights."""
-    pts = []
-    for i in range(L):
-        for j in range(L - i):
-            pts.append(((i + 1 / 3) / L, (j + 1 / 3) / L))
-            if i + j <= L - 2:
-                pts.append(((i + 2 / 3) / L, (j + 2 / 3) / L))
-    pts = np.array(pts)
-    X = shell.rest_positions
-    st_l, N_l, w_l = [], [], []
-    for f in faces:
-        st, N, dN, _ = ev.basis(int(f), pts)
-        a1 = np.einsum("qs,sd->qd", dN[:, :, 0], X[st])
-        a2 = np.einsum("qs,sd->qd", dN[:, :, 1], X[st])
-        st_l.append(st)
-        N_l.append(N)
-        w_l.append(np.linalg.norm(np.cross(a1, a2), axis=1) / (2 * L * L))
-    S = max(len(s) for s in st_l)
-    stn = np.zeros((len(faces), S), np.int64)
-    Nn = np.zeros((len(faces), len(pts), S))
-    for k, (s, N) in enumerate(zip(st_l, N_l)):
-        stn[k, : len(s)] = s
-        Nn[k, :, : len(s)] = N
-    return stn, Nn, np.array(w_l)
 
 
 @dataclass
@@ -268,7 +156,7 @@ class FingerContact(TermBase):
             raise ProblemError(f"finger contact '{self.name}': no shell face within reach ({reach:.3g} m) of the fingertip")
         spacing = self.spacing if self.spacing is not None else self._obs.feature_radius / 3
         L = int(np.clip(np.ceil(edge / spacing), 1, 12))
-        self._st, self._N, self._w = _samples(shell, ev, faces, L)
+        self._st, self._N, self._w = sample_faces(shell, ev, faces, L)
         self._faces, self._L, self._n = faces, L, shell.n_control
         self._shell, self._ev = shell, ev
         self._s = 0.0
@@ -509,7 +397,7 @@ class FingerContact(TermBase):
         f = ((p * self._w)[..., None] * n).reshape(-1, 3).sum(axis=0)   # force on the shell
         act = d < self._dh
         area = float(self._w[act].sum())
-        st, N, _ = _samples(self._shell, self._ev, self._faces, self._L * check_level)
+        st, N, _ = sample_faces(self._shell, self._ev, self._faces, self._L * check_level)
         d_fine = self._phi(np.einsum("fqs,fsd->fqd", N, x[st]), s, False)[0]
         return dict(base, advance_m=s, contact_force_N=f.tolist(), contact_force_along_axis_N=float(f @ self._e),
                     contact_area_m2=area, peak_pressure_Pa=float(p.max()),

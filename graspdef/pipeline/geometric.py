@@ -18,7 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..contact.barrier import Capsule, FingerContact, RoundedBox
+from ..contact.barrier import FingerContact
+from ..contact.obstacles import Capsule, RoundedBox
 from ..errors import ProblemError
 from ..problem.loads import PointLoad
 from ..solve.nonlinear import PathSolver, PathStopped

@@ -42,6 +42,7 @@ from ..problem.loads import BodyForce
 from ..problem.potentials import EnclosedGas
 from ..problem.problem import Problem
 from ..problem.supports import PointSupport, RigidModes
+from ..problem.terms import RestQuadratic
 from ..runs import derived as D
 from ..runs.record import SI_UNITS, RunRecord
 from ..runs.write import write_run
@@ -112,6 +113,7 @@ class GraspOutcome:
     displacement: np.ndarray       # (n, 3) the field of derived.max_displacement [m]
     contacts: dict                 # contacts.json
     path: tuple | None             # (header, rows) of path.csv
+    fields: dict                   # further per-vertex fields (SI; e.g. strain_energy_density [J/m^2])
 
 
 def prepare_object(scene, analysis: str = "nonlinear", gas: bool | None = None, control_faces: int | None = None,
@@ -299,8 +301,13 @@ def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solve
                                       "normal force per finger", "MuJoCo's settled normal contact force of each finger")
     derived["net_force_residual"] = D.entry(np.linalg.norm(residual_F), "N", "net force residual",
                                             "|sum of all forces on the shell|: what the rigid-mode support carries")
-    strain = sol.strain_energy if analysis == "linear" and not fingertips else \
-        ShellEnergy(shell).energy(shell.rest_positions + sol.u)
+    x_final = shell.rest_positions + sol.u
+    if analysis == "linear":           # the linear shell's energy (1/2) u.K0 u, also on a contact path
+        strain = sol.strain_energy if not fingertips else RestQuadratic(shell).evaluate(x_final, 0.0, 0).value
+        density = None
+    else:
+        energy = ShellEnergy(shell)
+        strain, density = energy.energy(x_final), energy.vertex_energy_density(x_final)
     derived["strain_energy"] = D.entry(float(strain), "J", "strain energy",
                                        "elastic energy of the shell at the final state, from its stress-free shape")
     conv = {"completed": solved.completed, "stop_reason": solved.stop_reason}
@@ -335,13 +342,14 @@ def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solve
     contacts = {"frame": "world", "units": {"length": "m", "force": "N"}, "object_pose": g.pose.record(),
                 "contacts": g.contacts.records(), "per_finger": data["mujoco"]["per_finger"]}
     path = path_rows(sol) if hasattr(sol, "path") else None
-    return GraspOutcome(rec, x_lim, verts, faces, u_def, contacts, path)
+    fields = {} if density is None else {"strain_energy_density": density}
+    return GraspOutcome(rec, x_lim, verts, faces, u_def, contacts, path, fields)
 
 
 def write_grasp_run(out, outcome: GraspOutcome, config: dict) -> Path:
     """Stage 6: the run folder (graspdef.runs.write_run)."""
     return write_run(out, outcome.record, rest=outcome.rest, deformed=outcome.deformed, faces=outcome.faces,
-                     displacement=outcome.displacement, path=outcome.path,
+                     displacement=outcome.displacement, path=outcome.path, vertex_fields=outcome.fields,
                      json_files={"contacts.json": outcome.contacts}, provenance=config)
 
 

@@ -4,7 +4,8 @@
 
 * ``result.json`` -- the :class:`~graspdef.runs.record.RunRecord`;
 * ``deformed.ply`` -- the deformed limit surface with per-vertex ``ux, uy, uz`` (the displacement
-  field that defines ``derived.max_displacement``) and ``displacement`` (its magnitude);
+  field that defines ``derived.max_displacement``), ``displacement`` (its magnitude) and, for
+  nonlinear runs, ``strain_energy_density`` [J/m^2];
 * ``undeformed.ply`` -- the limit surface at rest (the baseline of scan scores);
 * ``deformed.vtu`` -- the same surface and fields for ParaView (VTK XML, ASCII);
 * ``path.csv`` (a load path: one row per converged point; every column name carries its unit) and
@@ -52,12 +53,14 @@ def _vtu(path: Path, verts: np.ndarray, faces: np.ndarray, point_data: dict[str,
 def write_run(out: str | PathLike, record: RunRecord, *, rest: np.ndarray, deformed: np.ndarray,
               faces: np.ndarray, displacement: np.ndarray, path: tuple[list[str], list[list]] | None = None,
               path_u: tuple[np.ndarray, np.ndarray, object] | None = None, json_files: dict | None = None,
-              text_files: dict | None = None, provenance: dict | None = None) -> Path:
+              text_files: dict | None = None, provenance: dict | None = None,
+              vertex_fields: dict | None = None) -> Path:
     """Write a run folder (see the module docstring); return its path.
 
     ``rest``, ``deformed`` (n, 3): limit surface at rest and deformed; ``displacement`` (n, 3):
     the field of ``record.derived['max_displacement']``; ``path``: (header, rows) of path.csv;
-    ``path_u``: (u (k, n_control, 3), load factors (k,), limit map)."""
+    ``path_u``: (u (k, n_control, 3), load factors (k,), limit map); ``vertex_fields``: further
+    per-vertex scalars (n,), SI (e.g. ``strain_energy_density`` [J/m^2]), into both surfaces files."""
     unit = record.units["length"]
     rest, deformed, displacement = (np.asarray(a, dtype=float) for a in (rest, deformed, displacement))
     files = {"result": "result.json", "deformed": "deformed.ply", "undeformed": "undeformed.ply",
@@ -74,9 +77,11 @@ def write_run(out: str | PathLike, record: RunRecord, *, rest: np.ndarray, defor
         (tmp / "result.json").write_text(json.dumps(rec.to_json(), indent=2, default=float) + "\n")
         save_ply(tmp / "deformed.ply", deformed, faces, units=unit,
                  vertex_scalars={"ux": displacement[:, 0], "uy": displacement[:, 1], "uz": displacement[:, 2],
-                                 "displacement": mag})
+                                 "displacement": mag, **(vertex_fields or {})})
         save_ply(tmp / "undeformed.ply", rest, faces, units=unit)
-        _vtu(tmp / "deformed.vtu", deformed, faces, {"displacement": displacement, "displacement_magnitude": mag}, unit)
+        _vtu(tmp / "deformed.vtu", deformed, faces, {"displacement": displacement, "displacement_magnitude": mag,
+                                                     **{k: np.asarray(v, float) for k, v in (vertex_fields or {}).items()}},
+             unit)
         if path is not None:
             header, rows = path
             with open(tmp / "path.csv", "w", newline="") as fh:

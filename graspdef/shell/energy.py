@@ -260,6 +260,28 @@ class ShellEnergy:
         """Total elastic energy [J] at control points ``x`` (n_control, 3) [m]."""
         return float(sum((r.weights * W).sum() for _, r, _, W, _, _ in self._points(x, 0)))
 
+    def face_energies(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Elastic energy [J] and rest area [m^2] of every face of the control mesh (faces
+        without quadrature -- ghosts -- get 0)."""
+        nf = len(self.shell.mesh.faces)
+        E, A = np.zeros(nf), np.zeros(nf)
+        for (_, r, _, W, _, _), g in zip(self._points(x, 0), self.shell.basis.groups):
+            E[g.faces] = (r.weights * W).sum(axis=1)
+            A[g.faces] = r.weights.sum(axis=1)
+        return E, A
+
+    def vertex_energy_density(self, x: np.ndarray) -> np.ndarray:
+        """Strain energy per unit rest area [J/m^2] at each real control vertex: a third of the
+        energy of each incident real face over a third of its rest area (so that the density
+        times the vertex's area sums to the total energy)."""
+        mesh = self.shell.mesh
+        E, A = self.face_energies(x)
+        faces = mesh.faces[: mesh.n_real_faces]
+        num, den = np.zeros(mesh.n_real), np.zeros(mesh.n_real)
+        np.add.at(num, faces, np.repeat(E[: mesh.n_real_faces, None] / 3, 3, axis=1))
+        np.add.at(den, faces, np.repeat(A[: mesh.n_real_faces, None] / 3, 3, axis=1))
+        return num / np.where(den > 0, den, 1.0)
+
     def gradient(self, x: np.ndarray) -> tuple[float, np.ndarray]:
         """Energy and gradient (3 n_control,) [N]."""
         E, grad, _ = self._assemble(x, False)

@@ -13,6 +13,7 @@ from ..problem.config import ProblemSpec
 from ..runs import derived as D
 from ..runs.record import CONSISTENT_UNITS, SI_UNITS, RunRecord
 from ..runs.write import write_run as _write_run
+from ..shell.energy import ShellEnergy
 from .linear import LinearSolution
 from .nonlinear import NonlinearSolution
 
@@ -95,11 +96,14 @@ def write_run(out: str | Path, spec: ProblemSpec, sol: LinearSolution | Nonlinea
     L = sol.limit_map()
     verts, faces = sol.deformed_surface()
     path = path_u = None
+    fields = {}
     if isinstance(sol, NonlinearSolution):
         path = path_rows(sol, rec.units["length"], rec.units["energy"])
         path_u = (np.stack([p.u for p in sol.path]), sol.load_factors(), L)
+        shell = sol.problem.shell
+        fields["strain_energy_density"] = ShellEnergy(shell).vertex_energy_density(shell.rest_positions + sol.u)
     return _write_run(out, rec, rest=L @ sol.problem.shell.mesh.vertices, deformed=verts, faces=faces,
                       displacement=sol.vertex_displacements(), path=path, path_u=path_u,
-                      text_files={"problem.toml": config_text},
+                      text_files={"problem.toml": config_text}, vertex_fields=fields,
                       provenance={"problem_file": "problem.toml", "name": spec.name, "backend": spec.backend,
                                   "text": config_text})

@@ -195,3 +195,28 @@ def test_vtu_export_matches_the_ply(good_run):
     np.testing.assert_allclose(u, run.displacements, rtol=1e-15, atol=0)
     conn = np.array(piece.find("Cells/DataArray[@Name='connectivity']").text.split(), int).reshape(-1, 3)
     np.testing.assert_array_equal(conn, run.faces)
+
+
+def test_strain_energy_density_field_integrates_to_the_energy(good_run):
+    """deformed.ply's strain_energy_density [J/m^2] times each vertex's share of the rest area
+    (a third of each incident face) sums to the shell's elastic energy (an invariant of the
+    vertex lumping), and the field is non-negative."""
+    import trimesh
+
+    from graspdef.problem.config import load_problem
+    from graspdef.shell.energy import ShellEnergy
+
+    m = trimesh.load(good_run / "deformed.ply", process=False)
+    dens = np.asarray(m.metadata["_ply_raw"]["vertex"]["data"]["strain_energy_density"], float)
+    assert dens.min() >= 0 and dens.max() > 0
+    spec = load_problem(good_run / "problem.toml")
+    shell = spec.problem.shell
+    z = np.load(good_run / "path_u.npz")
+    u = z["u"][-1]
+    e = ShellEnergy(shell)
+    E, A = e.face_energies(shell.rest_positions + u)
+    mesh = shell.mesh
+    faces = mesh.faces[: mesh.n_real_faces]
+    area = np.zeros(mesh.n_real)
+    np.add.at(area, faces, np.repeat(A[: mesh.n_real_faces, None] / 3, 3, axis=1))
+    assert float(dens @ area) == pytest.approx(e.energy(shell.rest_positions + u), rel=1e-10)

@@ -1,0 +1,91 @@
+"""The fingertips as analytic rigid obstacles in the object frame: :class:`Capsule` (a pin) and
+:class:`RoundedBox` (a pad), each with its distance function phi (>= 0 outside), gradient and
+Hessian (graspdef.contact.barrier keeps the shell's samples out of them)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Capsule:
+    """A capsule (a pin): segment a-b [m] with ``radius`` [m].  Object-frame coordinates."""
+
+    a: tuple
+    b: tuple
+    radius: float
+
+    def inflated(self, r: float) -> "Capsule":
+        return Capsule(self.a, self.b, self.radius + r)
+
+    @property
+    def feature_radius(self) -> float:
+        return self.radius
+
+    def reach(self) -> float:
+        """Lateral extent about the closing axis [m]."""
+        return self.radius
+
+    def distance(self, p: np.ndarray, hessian: bool = True):
+        """phi (k,), grad (k, 3) and (``hessian``) Hessian (k, 3, 3) of the distance to the
+        capsule surface at points p (k, 3) outside it."""
+        a, b = np.asarray(self.a, float), np.asarray(self.b, float)
+        ab = b - a
+        L2 = ab @ ab
+        t = np.clip(((p - a) @ ab) / L2, 0.0, 1.0)
+        v = p - (a + t[:, None] * ab)
+        r = np.maximum(np.sqrt(np.einsum("ki,ki->k", v, v)), 1e-300)
+        n = v / r[:, None]
+        if not hessian:
+            return r - self.radius, n
+        P = np.eye(3)[None] - n[:, :, None] * n[:, None, :]
+        side = (t > 0) & (t < 1)                                # distance to the axis line
+        if side.any():
+            u = ab / np.sqrt(L2)
+            P[side] -= np.outer(u, u)[None]
+        return r - self.radius, n, P / r[:, None, None]
+
+
+@dataclass(frozen=True)
+class RoundedBox:
+    """A box with rounded edges (a pad): centre [m], rotation (3, 3) whose columns are the box
+    axes in the object frame, half extents [m] of the full box, edge radius ``rounding`` [m]."""
+
+    center: tuple
+    rotation: tuple
+    half_extents: tuple
+    rounding: float
+
+    def inflated(self, r: float) -> "RoundedBox":
+        return RoundedBox(self.center, self.rotation, tuple(h + r for h in self.half_extents), self.rounding + r)
+
+    @property
+    def feature_radius(self) -> float:
+        return self.rounding
+
+    def reach(self) -> float:
+        h = np.sort(np.asarray(self.half_extents, float))
+        return float(np.hypot(h[1], h[2]))
+
+    def distance(self, p: np.ndarray, hessian: bool = True):
+        """phi (k,), grad (k, 3) and (``hessian``) Hessian (k, 3, 3) of the distance to the
+        rounded box's surface at points p (k, 3) outside it."""
+        R = np.asarray(self.rotation, float)
+        c = np.asarray(self.center, float)
+        h = np.asarray(self.half_extents, float) - self.rounding        # inner box
+        loc = (p - c) @ R
+        s = np.where(loc < 0, -1.0, 1.0)
+        q = np.abs(loc) - h
+        m = np.maximum(q, 0.0)
+        r = np.sqrt(np.einsum("ki,ki->k", m, m))
+        inside = r <= 0
+        r = np.maximum(r, 1e-300)
+        nl = s * m / r[:, None]
+        phi = np.where(inside, q.max(axis=1), r) - self.rounding
+        n = nl @ R.T
+        if not hessian:
+            return phi, n
+        D = (q > 0).astype(float)
+        Hl = (D[:, :, None] * np.eye(3)[None] - nl[:, :, None] * nl[:, None, :]) / r[:, None, None]
+        return phi, n, R[None] @ Hl @ R.T[None]
