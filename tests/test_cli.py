@@ -231,3 +231,18 @@ def test_nonlinear_bad_input(tmp_path, capsys, edit, message):
     assert main(["solve", str(f), "--out", str(tmp_path / "run")]) == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "run").exists()
+
+
+def test_object_show_prints_what_a_grasp_uses(capsys):
+    """``graspdef object show``: the stated law with E and nu, the shell law of each analysis
+    (nu < 0.5: the compressible form), the gas with its source; an unknown scene is one line."""
+    assert main(["object", "show", "duck"]) == 0
+    out = capsys.readouterr().out
+    assert "law neo_hookean, E = 1 MPa, nu = 0.45" in out
+    assert "nonlinear analysis uses: compressible_neo_hookean" in out and "enclosed air: none" in out
+    assert main(["object", "show", "tennis_ball"]) == 0
+    out = capsys.readouterr().out
+    assert "nonlinear analysis uses: neo_hookean" in out and "p0 = 80 kPa gauge" in out and "source:" in out
+    assert main(["object", "show", "no_such_object"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "scene not found" in err[0]

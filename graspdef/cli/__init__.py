@@ -9,6 +9,7 @@ arguments into typed inputs and calls a library function.
     graspdef view RUN_DIR [RUN_DIR ...] [--host H] [--port P]   browse run folders (viser)
     graspdef report RUN_DIR [RUN_DIR ...] [--scan SCAN] [--out FILE]   self-contained HTML report
     graspdef sweep SPEC.toml --out DIR [--workers N | --scheduler tcp://HOST:PORT]   a grid of grasps
+    graspdef object show SCENE                 what a grasp of this object will use (law, E, nu, gas)
 
 Every error a user can cause prints one line ``graspdef: error: ...`` and exits with status 2.
 Building the parser imports no numerical package (``graspdef --help`` stays fast).
@@ -20,11 +21,11 @@ import logging
 import sys
 
 from ..errors import GraspdefError
-from . import bench, grasp, report, score, solve, sweep, view
+from . import bench, grasp, obj, report, score, solve, sweep, view
 
 #: subcommands in the order of ``graspdef --help``
 COMMANDS = {"solve": solve, "bench": bench, "score": score, "grasp": grasp, "view": view, "report": report,
-            "sweep": sweep}
+            "sweep": sweep, "object": obj}
 
 EPILOG = """examples:
   graspdef solve benchmarks/plate_ss_uniform.toml --out out/plate
@@ -32,6 +33,7 @@ EPILOG = """examples:
   graspdef solve benchmarks/nonlinear/cantilever_moment.toml --out out/rollup
   graspdef bench nonlinear --json out/bench_nonlinear.json
   graspdef score out/ball/deformed.ply ycb_056_tennis_ball --out out/ball_score
+  graspdef object show tennis_ball
   graspdef grasp tennis_ball --force 21.48 --out out/grasp_tennis_ball
   graspdef view out/plate out/rollup --port 8080
   graspdef report out/grasp_tennis_ball                            # -> out/grasp_tennis_ball/report.html

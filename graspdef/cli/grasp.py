@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import progress
+from ._common import progress, warn
 
 HELP = "MuJoCo grasp -> contacts -> shell deformation (a run folder)"
 DESCRIPTION = ("Close the scene's gripper to the force per finger, settle, map the contacts onto the object's shell "
@@ -28,6 +28,9 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
 def run(a: argparse.Namespace) -> int:
     """Run the chain for parsed arguments; prints two lines (the result, the run folder)."""
     from ..pipeline.grasp import run_grasp
+    from ..runs.folder import check_output_folder
+
+    check_output_folder(a.out)                    # before MuJoCo and the solve, not after
 
     gas = {"auto": None, "on": True, "off": False}[a.gas]
     from ..units import quantity
@@ -46,5 +49,7 @@ def run(a: argparse.Namespace) -> int:
           f"{d['max_displacement']['label']} {d['max_displacement']['value'] * 1e3:.2f} mm{area}{stop}; "
           f"{r['timings_s']['total']:.1f} s")
     print(f"run folder: {run.out}")
+    for w in r.get("warnings", []):
+        warn(w)
     progress(a, f"look at it: graspdef report {run.out}, or graspdef view {run.out}")
     return 0

@@ -5,7 +5,7 @@ import argparse
 import time
 from pathlib import Path
 
-from ._common import progress
+from ._common import progress, warn
 
 HELP = "solve a problem file (TOML) and write a run folder"
 DESCRIPTION = "Solve a problem file and write result.json, deformed.ply and a copy of the problem into --out."
@@ -28,6 +28,9 @@ def run(args: argparse.Namespace) -> int:
     from ..problem.config import load_problem
     from ..solve.output import result_record, write_run
 
+    from ..runs.folder import check_output_folder
+
+    check_output_folder(args.out)                 # before any work, not after the solve
     t0 = time.perf_counter()
     progress(args, f"reading {args.problem}")
     spec = load_problem(args.problem)
@@ -61,6 +64,8 @@ def run(args: argparse.Namespace) -> int:
     for name, p in rec["probes"].items():
         progress(args, f"probe {name}: u = [{', '.join(f'{c / ls:.6g}' for c in p['displacement'])}] {unit}")
     files = "result.json, deformed.ply, undeformed.ply" + (", path.csv" if rec["analysis"] == "nonlinear" else "")
+    for w in rec.get("warnings", []):
+        warn(w)
     md = rec.derived["max_displacement"]
     progress(args, f"{md['label']} {md['value'] / ls:.6g} {unit}; wrote {out}/ ({files}, SI units)")
     if stopped is not None:

@@ -337,6 +337,8 @@ def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solve
                      "fingertip inflated by t/2", "fingers": geo,
             "contact_area_definition": "sampled surface area with gap < dhat (contact pressure > 0)",
             "friction": "MuJoCo's contact forces less their finger-axis parts, as dead loads at the contacts"}
+    data["warnings"] = D.plausibility_warnings(analysis, derived["max_displacement"]["value"], spec.thickness,
+                                               float(np.ptp(x_lim, axis=0).max()))
     rec = RunRecord("grasp", spec.body, analysis, dict(SI_UNITS), derived, {}, data)
     verts, faces = sol.deformed_surface()
     contacts = {"frame": "world", "units": {"length": "m", "force": "N"}, "object_pose": g.pose.record(),

@@ -52,3 +52,21 @@ def displacement_field_label(derived: dict) -> str:
     """Colour-bar label of the stored displacement field (matches ``max_displacement``)."""
     md = derived.get("max_displacement") or {}
     return "|u| (rigid motion removed)" if md.get("rigid_motion_removed") else "|u|"
+
+
+def plausibility_warnings(analysis: str, max_displacement: float, thickness: float | None, size: float,
+                          unit: str = "m") -> list[str]:
+    """Loud warnings a result carries in its record (and the CLI prints): a linear result whose
+    displacement exceeds the thickness (linear theory assumes small rotations: use the nonlinear
+    analysis) or the object itself."""
+    out = []
+    to = 1e3 if unit == "m" else 1.0
+    u = "mm" if unit == "m" else unit
+    if size > 0 and max_displacement > size:
+        out.append(f"the max. displacement {max_displacement * to:.4g} {u} exceeds the object's size "
+                   f"{size * to:.4g} {u}: the result is not physical (check the thickness, modulus and loads)")
+    if analysis == "linear" and thickness and max_displacement > thickness:
+        out.append(f"linear result with a max. displacement of {max_displacement * to:.4g} {u}, more than the "
+                   f"thickness {thickness * to:.4g} {u}: linear theory does not hold there; use the nonlinear "
+                   "analysis")
+    return out

@@ -4,10 +4,35 @@ good folder."""
 from __future__ import annotations
 
 import contextlib
+import os
 import shutil
 import tempfile
 from os import PathLike
 from pathlib import Path
+
+from ..errors import GraspdefError
+
+
+class OutputFolderError(GraspdefError):
+    """An output folder cannot be written (checked before any work)."""
+
+
+def check_output_folder(out: str | PathLike) -> Path:
+    """Refuse, before any heavy work, an output folder that cannot be written or that holds
+    something other than a graspdef run (a run folder is replaced atomically at the end; a folder
+    of other files is never clobbered)."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise OutputFolderError(f"--out {out} is a file, not a folder")
+    if out.is_dir() and any(out.iterdir()) and not (out / "result.json").is_file():
+        raise OutputFolderError(f"--out {out} holds files that are not a graspdef run folder; give a new or empty "
+                                "folder (a run folder is replaced)")
+    parent = out.parent
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputFolderError(f"--out {out}: cannot create it ({parent} is not writable)")
+    return out
 
 
 @contextlib.contextmanager

@@ -396,6 +396,7 @@ def read_run(run_dir: str | PathLike, score_dir: str | PathLike | None = None) -
     if u.shape != dv.shape or not np.all(np.isfinite(u)):
         raise RunFolderError(f"{where}: deformed.ply: the displacement field is not finite on every vertex")
     run = RunData(d, rec, df, rv, dv, u)
+    run.notes += [f"warning: {w}" for w in (rec.get("warnings") or []) if isinstance(w, str)]
     if (d / "problem.toml").is_file():
         run.problem_file = d / "problem.toml"
     else:

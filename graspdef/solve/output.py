@@ -64,7 +64,11 @@ def result_record(spec: ProblemSpec, sol: LinearSolution | NonlinearSolution) ->
     derived = {"max_displacement": D.max_displacement(rest, sol.vertex_displacements(), L, rigid_motion_removed=False,
                                                       reference="rest shape")}
     t = np.asarray(sol.problem.shell.thickness, dtype=float)
+    warnings = D.plausibility_warnings("nonlinear" if isinstance(sol, NonlinearSolution) else "linear",
+                                       derived["max_displacement"]["value"], float(t.max()),
+                                       float(np.ptp(rest, axis=0).max()), L)
     data: dict = {"problem": spec.name, "thickness_m" if L == "m" else "thickness": float(t.max()),
+                  "warnings": warnings,
                   "probes": _probes(sol), **_mesh_counts(sol),
                   "timings_s": {k: float(v) for k, v in sol.timings.items()}}
     if isinstance(sol, NonlinearSolution):

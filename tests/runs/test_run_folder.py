@@ -220,3 +220,32 @@ def test_strain_energy_density_field_integrates_to_the_energy(good_run):
     area = np.zeros(mesh.n_real)
     np.add.at(area, faces, np.repeat(A[: mesh.n_real_faces, None] / 3, 3, axis=1))
     assert float(dens @ area) == pytest.approx(e.energy(shell.rest_positions + u), rel=1e-10)
+
+
+def test_output_folder_is_checked_before_any_work(tmp_path, capsys):
+    """A --out that holds other files, is a file, or cannot be created is refused in one line
+    before the problem is even read (so nothing is solved for nothing)."""
+    other = tmp_path / "photos"
+    other.mkdir()
+    (other / "holiday.jpg").write_bytes(b"x")
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    missing_problem = str(tmp_path / "nope.toml")           # would fail later, if the check came later
+    for out, msg in ((other, "not a graspdef run folder"), (afile, "is a file")):
+        assert main(["-q", "solve", missing_problem, "--out", str(out)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and msg in err[0], err
+    assert (other / "holiday.jpg").read_bytes() == b"x"
+
+
+def test_a_linear_result_beyond_the_thickness_carries_a_warning(tmp_path, capsys):
+    """Linear theory with a deflection larger than the thickness: the run is written, its record
+    carries the warning, the CLI prints it and the reader shows it among the run's notes."""
+    src = tmp_path / "p.toml"
+    src.write_text(CANTILEVER_MM.replace('type = "nonlinear"\nmethod = "load"\nsteps = 3', 'type = "linear"')
+                   .replace("force = [0.0, 0.0, 0.02]", "force = [0.0, 0.0, 0.2]"))
+    assert main(["solve", str(src), "--out", str(tmp_path / "run")]) == 0
+    err = capsys.readouterr().err
+    assert "graspdef: warning: linear result with a max. displacement" in err
+    run = read_run(tmp_path / "run")
+    assert run.max_displacement() > 1e-3 and any("use the nonlinear analysis" in n for n in run.notes)
