@@ -12,6 +12,10 @@ elsewhere the two differ by O(t/2 * angle^2), inside the barrier's reach d_hat o
 surfaces are nearly parallel anyway.  Inflating the obstacle keeps p_k linear in the control
 points (no normal derivatives), so the barrier's Hessian is exact and cheap.
 
+The term is three pieces: the samples (:mod:`graspdef.contact.sampling`), the barrier over them
+(:class:`FingerContact`, here) and the condensed finger advance
+(:mod:`graspdef.contact.condensation`); the fingertip shapes are :mod:`graspdef.contact.obstacles`.
+
 **Samples.**  The faces within the obstacle's reach (laterally, about its axis) are cut into
 L x L sub-triangles of their parameter domain, sampled at the sub-triangle centroids with weight
 |a1 x a2| / (2 L^2) (their rest area; the sum is the patch's limit-surface area); L is chosen so
@@ -45,7 +49,8 @@ import scipy.sparse as sp
 from ..errors import ProblemError
 from ..problem.terms import TermBase
 from .obstacles import Capsule, RoundedBox  # noqa: F401  (the fingertip shapes, used with FingerContact)
-from .sampling import sample_faces
+from .condensation import ForceControlledAdvance, NoPosition, condensed_load, condensed_rank_one
+from .sampling import sample_faces, select_faces
 from ..problem.terms import TermValue as PotentialTerms
 
 
@@ -57,11 +62,6 @@ from ..problem.terms import TermValue as PotentialTerms
 #: (the settings the contact tables were made with; the solver's defaults for smooth paths,
 #: reuse_ratio 0.9 and inertia_rtol 1e-4, stop the pinned ball at 12.9 of 20.37 N).
 CONTACT_PATH = {"desired_iterations": 8, "reuse_ratio": 0.5, "inertia_rtol": 0.0}
-
-
-class _NoPosition(ProblemError):
-    """No finger advance balances the force for this configuration (a sample point went
-    through the fingertip): the potential is +inf there."""
 
 
 # ---------------------------------------------------------------------------------------------
@@ -139,27 +139,10 @@ class FingerContact(TermBase):
         p = float(self.pressure_scale if self.pressure_scale is not None else (E or 1e6))
         self._kappa = p / (-float(log_barrier(np.array([self._dh / 2]), self._dh)[1][0]))
         X = shell.rest_positions
-        mesh = shell.mesh
-        real = mesh.faces[: mesh.n_real_faces]
-        edge = float(np.linalg.norm(X[real[:, [1, 2, 0]]] - X[real], axis=-1).mean())
-        cen = X[real].mean(axis=1)
-        # front of the obstacle (its farthest point along e) at s = 0
-        probe = self._front_point(X)
-        rel = cen - probe
-        ax = rel @ self._e
-        lat = np.linalg.norm(rel - ax[:, None] * self._e, axis=1)
-        reach = self.reach if self.reach is not None else self._obs.reach() + edge
-        ext = (X @ self._e).max() - (X @ self._e).min()
-        depth = self.depth if self.depth is not None else 0.5 * ext
-        faces = np.flatnonzero((lat <= reach) & (ax <= depth) & (ax >= -depth))
-        if len(faces) == 0:
-            raise ProblemError(f"finger contact '{self.name}': no shell face within reach ({reach:.3g} m) of the fingertip")
-        spacing = self.spacing if self.spacing is not None else self._obs.feature_radius / 3
-        L = int(np.clip(np.ceil(edge / spacing), 1, 12))
+        faces, L = select_faces(shell, self._obs, self._e, self.reach, self.depth, self.spacing, self.name)
         self._st, self._N, self._w = sample_faces(shell, ev, faces, L)
         self._faces, self._L, self._n = faces, L, shell.n_control
         self._shell, self._ev = shell, ev
-        self._s = 0.0
         x_s = self._points(X)
         phi = self._phi(x_s, 0.0, False)[0]
         self._first = int(np.argmin(phi))
@@ -167,16 +150,10 @@ class FingerContact(TermBase):
             raise ProblemError(f"finger contact '{self.name}': the fingertip starts {-phi.min():.3g} m inside the shell "
                                "(its reference position must touch the outer surface)")
         # start where the obstacle no longer reaches any sample (retracted by the overlap + dhat)
-        self._s = min(0.0, float(phi.min()) - self._dh)
-        self._s0 = self._s - 2 * self._dh - 0.5 * float(np.ptp(X @ self._e))
+        s0 = min(0.0, float(phi.min()) - self._dh)
+        self._s0 = s0 - 2 * self._dh - 0.5 * float(np.ptp(X @ self._e))
+        self._cond = ForceControlledAdvance(self._obs, self._e, self._dh, log_barrier, self.name, s0)
         return self
-
-    def _front_point(self, X):
-        # a point of the obstacle's front: the obstacle's distance-minimising point towards the
-        # shell's centroid, approximated by stepping from the centroid back along -e
-        c = X.mean(axis=0)
-        phi, n = self._obs.distance(c[None], False)
-        return c - phi[0] * n[0]
 
     # ---- kinematics --------------------------------------------------------------------------
     def _points(self, x: np.ndarray) -> np.ndarray:
@@ -188,94 +165,10 @@ class FingerContact(TermBase):
         out = self._obs.distance(pts.reshape(-1, 3) - s * self._e, hessian)
         return tuple(o.reshape(shp + o.shape[1:]) for o in out)
 
-    def _g(self, pts, kw, s):
-        """(B_s, B_ss, feasible) at advance s for flat sample points pts (k, 3), weights kw (k,)."""
-        d, n = self._obs.distance(pts - s * self._e, False)
-        if np.any(d <= 0):
-            return np.inf, 0.0, False
-        act = d < self._dh
-        if not act.any():
-            return 0.0, 0.0, True
-        _, b1, b2 = log_barrier(d[act], self._dh)
-        _, na, Ha = self._obs.distance(pts[act] - s * self._e, True)
-        ds = -(na @ self._e)
-        dss = np.einsum("i,kij,j->k", self._e, Ha, self._e)
-        kw = kw[act]
-        return float((kw * b1 * ds).sum()), float((kw * (b2 * ds * ds + b1 * dss)).sum()), True
-
     def advance(self, x: np.ndarray, F: float) -> float:
-        """The finger's advance s* [m] where the barrier force along e equals F [N] (F > 0).
-
-        Safeguarded Newton on dB/ds = F from the last solution, over the samples that can reach
-        the barrier within a window |s - s_c| < W around a centre s_c (|d d/d s| <= 1, so the
-        others are inactive and feasible there); the window moves when an iterate leaves it."""
-        P = self._points(x).reshape(-1, 3)
-        KW = (self._kappa * self._w).ravel()
-        W = 8 * self._dh
-        sel = {}
-
-        def window(sc):
-            d = self._obs.distance(P - sc * self._e, False)[0]
-            idx = np.flatnonzero(d < self._dh + W)
-            sel.update(c=sc, p=P[idx], kw=KW[idx])
-
-        def G(t):
-            if abs(t - sel["c"]) >= W:
-                window(t)
-            g, gs, ok = self._g(sel["p"], sel["kw"], t)
-            return (g - F if ok else np.inf), gs, ok
-
-        def dmin(t):
-            return float(self._obs.distance(P - t * self._e, False)[0].min())
-
-        def bracket(s):
-            """(lo, hi): G(lo) < 0 <= G(hi); advancing conservatively (never by more than 0.9 of
-            the smallest gap, so the fingertip cannot jump over a sample)."""
-            window(s)
-            Gs = G(s)[0]
-            step = self._dh
-            if Gs < 0:
-                lo = s
-                for _ in range(200):
-                    dm = dmin(lo)
-                    t = lo + min(step, 0.9 * dm)
-                    if G(t)[0] >= 0:
-                        return lo, t
-                    lo, step = t, 2 * step
-            else:
-                hi = s
-                for _ in range(60):
-                    t = hi - step
-                    if G(t)[0] < 0:
-                        return t, hi
-                    hi, step = t, 2 * step
-            return None
-
-        br = bracket(self._s) or bracket(0.0)
-        if br is None:
-            raise _NoPosition(f"finger contact '{self.name}': no finger position balances {F:.6g} N "
-                              "(a shell point is behind the fingertip)")
-        lo, hi = br
-        s = lo
-        Gs, gs, ok = G(s)
-        for _ in range(200):                                    # safeguarded Newton
-            if abs(Gs) <= 1e-12 * F or hi - lo <= 1e-15 * max(abs(lo), self._dh):
-                break
-            t = s - Gs / gs if (ok and gs > 0) else np.nan
-            if not (lo < t < hi):
-                t = 0.5 * (lo + hi)
-            Gt, gt, okt = G(t)
-            if Gt < 0:
-                lo = t
-            else:
-                hi = t
-            if okt:
-                small = abs(t - s) <= 1e-13 * self._dh
-                s, Gs, gs, ok = t, Gt, gt, okt
-                if small:
-                    break
-        self._s = s
-        return s
+        """The finger's advance s* [m] where the barrier force along e equals F [N] (F > 0):
+        graspdef.contact.condensation.ForceControlledAdvance over this term's samples."""
+        return self._cond.solve(self._points(x).reshape(-1, 3), (self._kappa * self._w).ravel(), F)
 
     # ---- potential interface ---------------------------------------------------------------------
     def scaled(self) -> bool:
@@ -330,7 +223,7 @@ class FingerContact(TermBase):
             return PotentialTerms(0.0, np.zeros(3 * self._n) if order >= 1 else None, z)
         try:
             s, value, grad, Hm, Bss, v = self._terms(x, F, 3 if order >= 2 else (2 if order == 1 else 1))
-        except _NoPosition:                                 # infeasible: the solver backs off
+        except NoPosition:                                 # infeasible: the solver backs off
             return PotentialTerms(np.inf, None if order == 0 else np.full(3 * self._n, np.nan),
                                   sp.csr_matrix((3 * self._n, 3 * self._n)) if order >= 2 else None)
         if order == 0:
@@ -338,8 +231,7 @@ class FingerContact(TermBase):
         self._last = (self._last[0], F, (Bss, v))
         if order < 2:
             return PotentialTerms(value, grad, None)
-        r1 = [(-1.0 / Bss, v)] if Bss > 0 else []
-        return PotentialTerms(value, grad, Hm, r1)
+        return PotentialTerms(value, grad, Hm, condensed_rank_one(Bss, v))
 
     def load(self, x: np.ndarray) -> np.ndarray:
         """-d(grad Pi)/d lam = -B_xs F_target / B_ss at the force of the last evaluation; with no
@@ -358,11 +250,9 @@ class FingerContact(TermBase):
         else:
             try:
                 _, _, _, _, Bss, v = self._terms(x, F, 2)
-            except _NoPosition:
+            except NoPosition:
                 return np.full(3 * self._n, np.nan)
-        if not Bss > 0:
-            return np.zeros(3 * self._n)
-        return -v * self.force / Bss
+        return condensed_load(Bss, v, self.force)
 
     def commit(self, x: np.ndarray) -> None:
         pass

@@ -1,8 +1,43 @@
-"""Where the contact barrier looks: samples of the shell's limit surface on the faces near a
-fingertip (sub-triangle centroids of each face's parameter domain, weighted by their rest area)."""
+"""Where the contact barrier looks: the faces near a fingertip (:func:`select_faces`) and samples of
+the shell's limit surface on them (:func:`sample_faces`: sub-triangle centroids of each face's
+parameter domain, weighted by their rest area)."""
 from __future__ import annotations
 
 import numpy as np
+
+from ..errors import ProblemError
+
+
+def select_faces(shell, obstacle, e: np.ndarray, reach: float | None, depth: float | None,
+                 spacing: float | None, name: str) -> tuple[np.ndarray, int]:
+    """The real faces within the fingertip's reach and the sub-division L of each into L x L
+    sample triangles.
+
+    ``reach`` [m]: lateral radius about the axis ``e`` (faces whose control centroid is within it;
+    default: the obstacle's lateral extent plus one control-mesh edge); ``depth`` [m]: at most this
+    far in front of / behind the obstacle's front (default: half the shell's extent along e);
+    ``spacing`` [m]: largest sample spacing (default: a third of the obstacle's smallest radius of
+    curvature)."""
+    X = shell.rest_positions
+    mesh = shell.mesh
+    real = mesh.faces[: mesh.n_real_faces]
+    edge = float(np.linalg.norm(X[real[:, [1, 2, 0]]] - X[real], axis=-1).mean())
+    cen = X[real].mean(axis=1)
+    # front of the obstacle at s = 0: its distance-minimising point towards the shell's centroid
+    c = X.mean(axis=0)
+    phi, n = obstacle.distance(c[None], False)
+    probe = c - phi[0] * n[0]
+    rel = cen - probe
+    ax = rel @ e
+    lat = np.linalg.norm(rel - ax[:, None] * e, axis=1)
+    reach = reach if reach is not None else obstacle.reach() + edge
+    ext = (X @ e).max() - (X @ e).min()
+    depth = depth if depth is not None else 0.5 * ext
+    faces = np.flatnonzero((lat <= reach) & (ax <= depth) & (ax >= -depth))
+    if len(faces) == 0:
+        raise ProblemError(f"finger contact '{name}': no shell face within reach ({reach:.3g} m) of the fingertip")
+    spacing = spacing if spacing is not None else obstacle.feature_radius / 3
+    return faces, int(np.clip(np.ceil(edge / spacing), 1, 12))
 
 
 def sample_faces(shell, ev, faces: np.ndarray, L: int):

@@ -9,7 +9,7 @@ import numpy as np
 from ..problem.problem import Problem
 from ..shell.energy import ShellEnergy
 from .result import DisplacementField
-from .sparse import KKTResult, solve_kkt
+from .sparse import KKTResult, KKTSystem, solve_kkt
 
 
 @dataclass
@@ -42,14 +42,45 @@ class LinearSolution(DisplacementField):
         return f.sum(0), np.cross(x, f).sum(0)
 
 
-def solve_linear(problem: Problem, backend: str = "auto") -> LinearSolution:
-    """Assemble K0 (Hessian at rest), the load vector and the support constraints, and solve."""
-    t0 = time.perf_counter()
+def rest_stiffness(problem: Problem):
+    """K0: the Hessian of the shell energy at rest plus the Nitsche terms of rotation-fixed edges."""
     shell = problem.shell
     _, _, K = ShellEnergy(shell).hessian(shell.rest_positions)
     Kb = problem.boundary_stiffness()
     if Kb.nnz:
         K = (K + Kb).tocsr()
+    return K
+
+
+class LinearResponse:
+    """The factorised linear problem, for many scalings of its loads and moduli (the viewer's live
+    re-solves): u = (load scale / modulus scale) u_f + u_g, exact in linear theory.
+
+    ``u_f`` (n_control, 3): the response to the loads at scale 1; ``u_g``: to the prescribed
+    displacements."""
+
+    def __init__(self, problem: Problem, backend: str = "auto"):
+        K = rest_stiffness(problem)
+        f = problem.load_vector()
+        C, _, g = problem.constraints(with_targets=True)
+        self.kkt = KKTSystem(C, backend)
+        self.kkt.factor(K)
+        uf, _, _ = self.kkt.solve(f)
+        self.u_f = uf.reshape(-1, 3)
+        self.u_g = self.kkt.solve(np.zeros_like(f), g)[0].reshape(-1, 3) if np.any(g) else np.zeros_like(self.u_f)
+
+    def displacements(self, load_scale: float, modulus_scale: float) -> np.ndarray:
+        """Control-point displacements (n_control, 3) [m] at the scaled loads and moduli."""
+        return load_scale / modulus_scale * self.u_f + self.u_g
+
+    def close(self) -> None:
+        self.kkt.close()
+
+
+def solve_linear(problem: Problem, backend: str = "auto") -> LinearSolution:
+    """Assemble K0 (Hessian at rest), the load vector and the support constraints, and solve."""
+    t0 = time.perf_counter()
+    K = rest_stiffness(problem)
     t1 = time.perf_counter()
     f = problem.load_vector()
     C, _, g = problem.constraints(with_targets=True)

@@ -22,9 +22,8 @@ import numpy as np
 from ..problem.config import load_problem
 from ..problem.loads import PointLoad
 from ..problem.potentials import EnclosedGas
-from ..shell.energy import ShellEnergy
 from ..solve.nonlinear import PathOptions, PathSolver, path_options, solve_nonlinear
-from ..solve.sparse import KKTSystem
+from ..solve.linear import LinearResponse
 from ..subdivision.rules import limit_matrix
 from ..runs.read import RunData
 
@@ -72,7 +71,7 @@ class LiveModel:
         self.nonlinear = run.analysis == "nonlinear"
         self.max_cuts = max_cuts
         self.backend = backend
-        self.kkt: KKTSystem | None = None
+        self.linear: LinearResponse | None = None
         self.solver: PathSolver | None = None
         if self.nonlinear:
             opts = path_options(self.spec.solver)
@@ -85,24 +84,14 @@ class LiveModel:
             self.u = None                                  # (3 n_control,) current converged state
             self.lam = None
         else:
-            K = ShellEnergy(shell).hessian(shell.rest_positions)[2]
-            Kb = self.problem.boundary_stiffness()
-            if Kb.nnz:
-                K = (K + Kb).tocsr()
-            f = self.problem.load_vector()
-            C, _, g = self.problem.constraints(with_targets=True)
-            self.kkt = KKTSystem(C, backend)
-            self.kkt.factor(K)
-            uf, _, _ = self.kkt.solve(f)
-            self.u_f = uf.reshape(-1, 3)
-            self.u_g = self.kkt.solve(np.zeros_like(f), g)[0].reshape(-1, 3) if np.any(g) else np.zeros_like(self.u_f)
+            self.linear = LinearResponse(self.problem, backend)
             self.modulus_ok = True
             self.lam_end = 1.0
         self.seconds_setup = time.perf_counter() - t0
 
     def close(self) -> None:
-        if self.kkt is not None:
-            self.kkt.close()
+        if self.linear is not None:
+            self.linear.close()
         if self.solver is not None:
             self.solver.eq.close()
 
@@ -142,7 +131,7 @@ class LiveModel:
             return LiveResult(False, None, force_scale, modulus_scale, None, 0.0,
                               "modulus changes are off for this run (prescribed displacements or enclosed gas)")
         if not self.nonlinear:
-            u = force_scale / modulus_scale * self.u_f + self.u_g
+            u = self.linear.displacements(force_scale, modulus_scale)
             return LiveResult(True, self.L @ u, force_scale, modulus_scale, force_scale, time.perf_counter() - t0,
                               "linear: exact")
         if self.u is None:

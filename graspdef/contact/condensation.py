@@ -1,0 +1,126 @@
+"""The force-controlled finger: its advance s along the closing axis e is not an unknown of the
+solver but is condensed out exactly (graspdef.contact.barrier's module docstring): for control
+points x, s*(x) solves dB/ds = F, found here by a safeguarded scalar Newton iteration; the
+condensed Hessian is B_xx - B_xs B_xs^T / B_ss (a rank-one part with a negative coefficient) and
+the load direction -B_xs F_target / B_ss."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ProblemError
+
+
+class NoPosition(ProblemError):
+    """No finger advance balances the force for this configuration (a sample point went
+    through the fingertip): the potential is +inf there."""
+
+
+class ForceControlledAdvance:
+    """The condensed degree of freedom: the advance s [m] of an obstacle along the unit axis e
+    where the barrier force of the samples equals F.  ``barrier``: the function b(d) -> (b, b',
+    b'') of the gap; ``dhat``: its reach; ``s``: the starting advance (kept: each solve starts
+    from the last solution)."""
+
+    def __init__(self, obstacle, e: np.ndarray, dhat: float, barrier, name: str, s: float = 0.0):
+        self._obs, self._e, self._dh, self._barrier, self.name = obstacle, e, dhat, barrier, name
+        self.s = s
+
+    def derivatives(self, pts, kw, s):
+        """(B_s, B_ss, feasible) at advance s for flat sample points pts (k, 3), weights kw (k,)."""
+        d, n = self._obs.distance(pts - s * self._e, False)
+        if np.any(d <= 0):
+            return np.inf, 0.0, False
+        act = d < self._dh
+        if not act.any():
+            return 0.0, 0.0, True
+        _, b1, b2 = self._barrier(d[act], self._dh)
+        _, na, Ha = self._obs.distance(pts[act] - s * self._e, True)
+        ds = -(na @ self._e)
+        dss = np.einsum("i,kij,j->k", self._e, Ha, self._e)
+        kw = kw[act]
+        return float((kw * b1 * ds).sum()), float((kw * (b2 * ds * ds + b1 * dss)).sum()), True
+
+    def solve(self, P: np.ndarray, KW: np.ndarray, F: float) -> float:
+        """The advance s* [m] where the barrier force along e of the sample points P (k, 3) with
+        weights KW (k,) equals F [N] (F > 0).
+
+        Safeguarded Newton on dB/ds = F from the last solution, over the samples that can reach
+        the barrier within a window |s - s_c| < W around a centre s_c (|d d/d s| <= 1, so the
+        others are inactive and feasible there); the window moves when an iterate leaves it."""
+        W = 8 * self._dh
+        sel = {}
+
+        def window(sc):
+            d = self._obs.distance(P - sc * self._e, False)[0]
+            idx = np.flatnonzero(d < self._dh + W)
+            sel.update(c=sc, p=P[idx], kw=KW[idx])
+
+        def G(t):
+            if abs(t - sel["c"]) >= W:
+                window(t)
+            g, gs, ok = self.derivatives(sel["p"], sel["kw"], t)
+            return (g - F if ok else np.inf), gs, ok
+
+        def dmin(t):
+            return float(self._obs.distance(P - t * self._e, False)[0].min())
+
+        def bracket(s):
+            """(lo, hi): G(lo) < 0 <= G(hi); advancing conservatively (never by more than 0.9 of
+            the smallest gap, so the fingertip cannot jump over a sample)."""
+            window(s)
+            Gs = G(s)[0]
+            step = self._dh
+            if Gs < 0:
+                lo = s
+                for _ in range(200):
+                    dm = dmin(lo)
+                    t = lo + min(step, 0.9 * dm)
+                    if G(t)[0] >= 0:
+                        return lo, t
+                    lo, step = t, 2 * step
+            else:
+                hi = s
+                for _ in range(60):
+                    t = hi - step
+                    if G(t)[0] < 0:
+                        return t, hi
+                    hi, step = t, 2 * step
+            return None
+
+        br = bracket(self.s) or bracket(0.0)
+        if br is None:
+            raise NoPosition(f"finger contact '{self.name}': no finger position balances {F:.6g} N "
+                             "(a shell point is behind the fingertip)")
+        lo, hi = br
+        s = lo
+        Gs, gs, ok = G(s)
+        for _ in range(200):                                    # safeguarded Newton
+            if abs(Gs) <= 1e-12 * F or hi - lo <= 1e-15 * max(abs(lo), self._dh):
+                break
+            t = s - Gs / gs if (ok and gs > 0) else np.nan
+            if not (lo < t < hi):
+                t = 0.5 * (lo + hi)
+            Gt, gt, okt = G(t)
+            if Gt < 0:
+                lo = t
+            else:
+                hi = t
+            if okt:
+                small = abs(t - s) <= 1e-13 * self._dh
+                s, Gs, gs, ok = t, Gt, gt, okt
+                if small:
+                    break
+        self.s = s
+        return s
+
+
+def condensed_rank_one(Bss: float, v: np.ndarray) -> list:
+    """The rank-one Hessian part -B_xs B_xs^T / B_ss of the condensed advance ([] when B_ss <= 0)."""
+    return [(-1.0 / Bss, v)] if Bss > 0 else []
+
+
+def condensed_load(Bss: float, v: np.ndarray, force: float) -> np.ndarray:
+    """-d(grad Pi)/d lam = -B_xs F_target / B_ss (zero when B_ss <= 0)."""
+    if not Bss > 0:
+        return np.zeros_like(v)
+    return -v * force / Bss
