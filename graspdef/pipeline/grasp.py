@@ -146,6 +146,16 @@ def prepare_object(scene, analysis: str = "nonlinear", gas: bool | None = None, 
     return GraspObject(xml, spec, shell, shell_info, p0)
 
 
+def check_force(scene, force: float) -> None:
+    """Refuse, before any heavy work, a per-finger force outside the scene's gripper range."""
+    from ..sim.grasp import check_targets
+    from ..sim.scene import load_scene
+
+    xml = scene_xml(scene)
+    spec = load_object(xml)
+    check_targets(load_scene(xml, spec.body), {s: (force if s in spec.fingers else 0.0) for s in ("left", "right")})
+
+
 def settle(obj: GraspObject, force: float, settings: GraspSettings = GraspSettings()) -> Settled:
     """Stage 2: close the gripper to ``force`` [N] per finger in MuJoCo and settle."""
     if not np.isfinite(force) or force <= 0:
@@ -366,6 +376,7 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
                            f"got {contact!r}")
     if not np.isfinite(force) or force <= 0:
         raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
+    check_force(scene, force)                 # the gripper's range, before the shell is built
     obj = prepare_object(scene, analysis, gas, control_faces, E)
     t_shell = time.perf_counter()
     st = settle(obj, force, settings)

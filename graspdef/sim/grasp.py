@@ -151,6 +151,31 @@ def _speed(sc: Scene) -> float:
     return float(max(v))
 
 
+def force_range(sc: Scene) -> dict:
+    """Per finger, the squeezing force range [N] of the gripper model (its actuator's control
+    range times its gear; unlimited: (-inf, inf))."""
+    m = sc.model
+    out = {}
+    for s in SIDES:
+        a = sc.fingers[s][3]
+        lo, hi = (m.actuator_ctrlrange[a] if m.actuator_ctrllimited[a] else (-np.inf, np.inf))
+        out[s] = (lo * m.actuator_gear[a, 0], hi * m.actuator_gear[a, 0])
+    return out
+
+
+def check_targets(sc: Scene, targets: dict) -> None:
+    """Refuse a target force that is not a non-negative number or lies outside the gripper's
+    force range (a clear error, never a silent clip)."""
+    rng = force_range(sc)
+    for s, f in targets.items():
+        lo, hi = rng[s]
+        if not np.isfinite(f) or f < 0:
+            raise SimError(f"{s} finger: target force must be a non-negative number [N], got {f!r}")
+        if f > hi or f < lo:
+            raise SimError(f"{s} finger: target force {f:g} N is beyond what the gripper can exert "
+                           f"({lo:g}..{hi:g} N, its actuator's range in the scene)")
+
+
 def grasp(scene, force: float | dict, object: str, settings: GraspSettings = GraspSettings()) -> GraspResult:
     """Close the gripper of ``scene`` (a path or a :class:`Scene`) on body ``object`` until each
     finger presses with its target force [N], settle and extract the contacts.
@@ -166,14 +191,7 @@ def grasp(scene, force: float | dict, object: str, settings: GraspSettings = Gra
     sc = scene if isinstance(scene, Scene) else load_scene(scene, object)
     m, d = sc.model, sc.data
     targets = {s: float(force) for s in SIDES} if np.isscalar(force) else {s: float(force.get(s, 0.0)) for s in SIDES}
-    for s, f in targets.items():
-        a = sc.fingers[s][3]
-        lo, hi = (m.actuator_ctrlrange[a] if m.actuator_ctrllimited[a] else (-np.inf, np.inf))
-        if not np.isfinite(f) or f < 0:
-            raise SimError(f"{s} finger: target force must be a non-negative number [N], got {f!r}")
-        if f > hi * m.actuator_gear[a, 0] or f < lo * m.actuator_gear[a, 0]:
-            raise SimError(f"{s} finger: target force {f:g} N is beyond what the actuator can exert "
-                           f"({lo * m.actuator_gear[a, 0]:g}..{hi * m.actuator_gear[a, 0]:g} N)")
+    check_targets(sc, targets)
     active = [s for s in SIDES if targets[s] > 0]
     if not active:
         raise SimError("no finger has a positive target force")

@@ -35,7 +35,6 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
-import math
 from dataclasses import asdict, dataclass
 from os import PathLike
 from pathlib import Path
@@ -146,13 +145,10 @@ def _actuator_range(xml: Path, body: str, path: str) -> tuple[float, float]:
         sc = load_scene(xml, body)
     except GraspdefError as exc:
         raise ProblemError(f"{path}: [grid] scenes: {exc}") from exc
-    m = sc.model
-    lo, hi = -math.inf, math.inf
-    for _b, _q, _d, a in sc.fingers.values():
-        if m.actuator_ctrllimited[a]:
-            g = float(m.actuator_gear[a, 0])
-            lo, hi = max(lo, float(m.actuator_ctrlrange[a, 0]) * g), min(hi, float(m.actuator_ctrlrange[a, 1]) * g)
-    return lo, hi
+    from ..sim.grasp import force_range
+
+    ranges = force_range(sc).values()               # the force every finger can exert
+    return max(float(r[0]) for r in ranges), min(float(r[1]) for r in ranges)
 
 
 def parse_spec(text: str, path: str = "<spec>") -> SweepSpec:

@@ -40,7 +40,7 @@ def test_sphere_squeezed_to_target(scene, force):
 
 
 def test_force_beyond_actuator_range():
-    with pytest.raises(SimError, match="beyond what the actuator"):
+    with pytest.raises(SimError, match="beyond what the gripper"):
         grasp(SCENES / "test_sphere" / "scene.xml", 45.0, "sphere")
 
 
