@@ -31,6 +31,10 @@ def run(args: argparse.Namespace) -> int:
     from ..registration import score_cli
 
     pred, offset = Path(args.prediction), args.surface_offset_mm
+    if not pred.exists():
+        from ..errors import ProblemError
+
+        raise ProblemError(f"prediction {pred} does not exist (give a run folder or its deformed.ply)")
     folder = pred if pred.is_dir() else (pred.parent if (pred.parent / "result.json").is_file() else None)
     if folder is not None:                 # a run folder: read (and check) it with the one reader
         from ..runs.read import read_run

@@ -1,0 +1,177 @@
+"""The bad-input matrix (issue 15): every class of bad input a user can give any subcommand is
+answered with exit status 2 and one line ``graspdef: error: ...`` naming the file, key or value
+and what is accepted -- never a traceback -- and nothing is written."""
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from graspdef.cli import main
+
+REPO = Path(__file__).resolve().parents[1]
+
+PLATE = """
+name = "plate"
+[units]
+length = "mm"
+force = "N"
+[geometry]
+type = "rectangle"
+lx = 100.0
+ly = 100.0
+nx = 4
+ny = 4
+[material]
+E = 1000.0
+nu = 0.3
+[shell]
+thickness = 1.0
+[regions]
+edges = "abs(abs(x) - 50) < 1e-6 or abs(abs(y) - 50) < 1e-6"
+[[supports]]
+kind = "simply_supported"
+region = "edges"
+[[loads]]
+kind = "point"
+at = [0.0, 0.0, 0.0]
+force = [0.0, 0.0, -1.0]
+"""
+
+TRI = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+
+SPEC = """
+[sweep]
+name = "bad"
+[grid]
+scenes = ["tennis_ball"]
+forces_N = [5.0]
+materials = ["linear"]
+contacts = ["point"]
+control_faces = [320]
+"""
+
+
+def _scene_copy(tmp: Path, edit) -> str:
+    """A copy of the tennis-ball scene with its gripper beside it (the include stays valid), its
+    object.toml edited by ``edit``; returns the scene folder."""
+    root = tmp / "scenes"
+    shutil.copytree(REPO / "scenes" / "parallel_gripper", root / "parallel_gripper")
+    shutil.copytree(REPO / "scenes" / "tennis_ball", root / "tennis_ball")
+    f = root / "tennis_ball" / "object.toml"
+    f.write_text(edit(f.read_text()))
+    return str(root / "tennis_ball")
+
+
+def _replace(old: str, new: str):
+    def edit(text: str) -> str:
+        assert old in text, old
+        return text.replace(old, new, 1)
+    return edit
+
+
+def _file(tmp: Path, name: str, text: str | bytes) -> str:
+    p = tmp / name
+    p.write_bytes(text) if isinstance(text, bytes) else p.write_text(text)
+    return str(p)
+
+
+def _case(name: str, tmp: Path) -> tuple[list[str], str]:
+    """(argv, a phrase the error line must contain)."""
+    out = str(tmp / "out")
+    plate = lambda text: _file(tmp, "p.toml", text)  # noqa: E731
+    cases = {
+        # --- solve: problem files
+        "solve: missing file": lambda: (["solve", str(tmp / "nope.toml"), "--out", out], "nope.toml"),
+        "solve: TOML syntax": lambda: (["solve", plate(PLATE + "\n[oops\n"), "--out", out], "line"),
+        "solve: unknown key": lambda: (["solve", plate(PLATE.replace("thickness = 1.0", "thicknes = 1.0")), "--out", out],
+                               "did you mean 'thickness'"),
+        "solve: missing units": lambda: (["solve", plate(PLATE.replace('[units]\nlength = "mm"\nforce = "N"\n', "")),
+                                  "--out", out], "[units]"),
+        "solve: unknown unit": lambda: (["solve", plate(PLATE.replace('length = "mm"', 'length = "furlong"')), "--out", out],
+                                "furlong"),
+        "solve: NaN": lambda: (["solve", plate(PLATE.replace("E = 1000.0", "E = nan")), "--out", out], "finite"),
+        "solve: zero thickness": lambda: (["solve", plate(PLATE.replace("thickness = 1.0", "thickness = 0.0")),
+                                   "--out", out], "thickness"),
+        "solve: nu above 0.5": lambda: (["solve", plate(PLATE.replace("nu = 0.3", "nu = 0.7")), "--out", out], "Poisson"),
+        "solve: binary garbage": lambda: (["solve", _file(tmp, "g.toml", bytes(range(256))), "--out", out], "g.toml"),
+        "solve: --out holds other files": lambda: (["solve", plate(PLATE), "--out", str(tmp / "photos")],
+                                           "not a graspdef run folder"),
+        "solve: --out is a file": lambda: (["solve", plate(PLATE), "--out", _file(tmp, "afile", "x")], "is a file"),
+        # --- grasp
+        "grasp: unknown scene": lambda: (["grasp", "no_such_scene", "--force", "5", "--out", out], "scene not found"),
+        "grasp: force beyond the gripper": lambda: (["grasp", "tennis_ball", "--force", "1e9", "--out", out],
+                                            "beyond what the gripper can exert"),
+        "grasp: negative force": lambda: (["grasp", "tennis_ball", "--force", "-3", "--out", out], "force"),
+        "grasp: NaN force": lambda: (["grasp", "tennis_ball", "--force", "nan", "--out", out], "force"),
+        "grasp: gas on without [gas]": lambda: (["grasp", "duck", "--force", "5", "--gas", "on", "--out", out], "[gas]"),
+        "grasp: gas with a linear shell": lambda: (["grasp", "tennis_ball", "--force", "5", "--gas", "on", "--analysis",
+                                            "linear", "--out", out], "nonlinear"),
+        "grasp: bad E": lambda: (["grasp", "tennis_ball", "--force", "5", "--E-MPa", "-1", "--out", out], "E"),
+        "grasp: --out holds other files": lambda: (["grasp", "tennis_ball", "--force", "5", "--out", str(tmp / "photos")],
+                                           "not a graspdef run folder"),
+        # --- object data (object.toml beside a scene)
+        "object: unknown key": lambda: (["object", "show", _scene_copy(tmp, _replace("[gas]", "[gass]"))], "gass"),
+        "object: wrong dimension": lambda: (["object", "show", _scene_copy(tmp, _replace('thickness = "2.5 mm"',
+                                                                                  'thickness = "2.5 kg"'))], "kg"),
+        "object: unknown scene": lambda: (["object", "show", "no_such_scene"], "scene not found"),
+        # --- report / view / score on run folders
+        "report: missing folder": lambda: (["report", str(tmp / "nowhere")], "does not exist"),
+        "report: not a run folder": lambda: (["report", str(tmp / "photos")], "incomplete"),
+        "report: bad table file": lambda: (["report", "--table", _file(tmp, "t.csv", "folder\nx\n"), "--out",
+                                    str(tmp / "r.html")], "'run' column"),
+        "view: missing folder": lambda: (["view", str(tmp / "nowhere"), "--port", "0"], "does not exist"),
+        "score: missing prediction": lambda: (["score", str(tmp / "nowhere.ply"), "ycb_056_tennis_ball", "--out", out],
+                                      "nowhere.ply"),
+        "score: unknown scan id": lambda: (["score", _file(tmp, "pred.obj", TRI), "no_such_scan_id", "--undeformed",
+                                            str(tmp / "pred.obj"), "--prediction-units", "m", "--out", out], "no_such_scan_id"),
+        "score: empty scan": lambda: (["score", _file(tmp, "pred.obj", TRI), "--undeformed", str(tmp / "pred.obj"), "--prediction-units", "m",
+                               _file(tmp, "empty.ply", "ply\nformat ascii 1.0\ncomment units mm\nelement vertex 0\n"
+                                     "property float x\nproperty float y\nproperty float z\nend_header\n"),
+                               "--out", out], "empty.ply"),
+        # --- sweep
+        "sweep: unknown key": lambda: (["sweep", _file(tmp, "s.toml", SPEC.replace("[grid]", "[gridd]")), "--out", out],
+                               "gridd"),
+        "sweep: force beyond the gripper": lambda: (["sweep", _file(tmp, "s.toml", SPEC.replace("[5.0]", "[500.0]")),
+                                             "--out", out], "beyond what the actuators"),
+        "sweep: unreachable scheduler": lambda: (["sweep", _file(tmp, "s.toml", SPEC), "--out", out, "--scheduler",
+                                          "tcp://127.0.0.1:9"], "127.0.0.1:9"),
+        # --- bench
+        "bench: missing folder": lambda: (["bench", "linear", "--dir", str(tmp / "nowhere")], "nowhere"),
+    }
+    return cases[name]()
+
+
+NAMES = sorted([
+    "solve: missing file", "solve: TOML syntax", "solve: unknown key", "solve: missing units", "solve: unknown unit",
+    "solve: NaN", "solve: zero thickness", "solve: nu above 0.5", "solve: binary garbage",
+    "solve: --out holds other files", "solve: --out is a file", "grasp: unknown scene",
+    "grasp: force beyond the gripper", "grasp: negative force", "grasp: NaN force", "grasp: gas on without [gas]",
+    "grasp: gas with a linear shell", "grasp: bad E", "grasp: --out holds other files", "object: unknown key",
+    "object: wrong dimension", "object: unknown scene", "report: missing folder", "report: not a run folder",
+    "report: bad table file", "view: missing folder", "score: missing prediction", "score: unknown scan id",
+    "score: empty scan", "sweep: unknown key", "sweep: force beyond the gripper", "sweep: unreachable scheduler",
+    "bench: missing folder"])
+
+
+def test_the_matrix_has_at_least_30_classes():
+    assert len(NAMES) >= 30
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_bad_input_is_one_line_exit_2_and_writes_nothing(name, tmp_path, capsys):
+    photos = tmp_path / "photos"
+    photos.mkdir()
+    (photos / "holiday.jpg").write_bytes(b"jpeg")
+    argv, phrase = _case(name, tmp_path)
+    before = sorted(str(p) for p in tmp_path.rglob("*"))
+    code = main(["-q", *argv])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2, (name, err)
+    assert len(err) == 1 and err[0].startswith("graspdef: error:"), (name, err)
+    assert phrase in err[0], (name, err[0])
+    assert sorted(str(p) for p in tmp_path.rglob("*")) == before, name          # nothing written
+    assert (photos / "holiday.jpg").read_bytes() == b"jpeg"
+    json.dumps(err)                                                              # plain text
