@@ -117,6 +117,9 @@ def _case(name: str, tmp: Path) -> tuple[list[str], str]:
         "object: wrong dimension": lambda: (["object", "show", _scene_copy(tmp, _replace('thickness = "2.5 mm"',
                                                                                   'thickness = "2.5 kg"'))], "kg"),
         "object: unknown scene": lambda: (["object", "show", "no_such_scene"], "scene not found"),
+        "grasp: thickness outside the thin-shell range": lambda: (
+            ["grasp", _scene_copy(tmp, _replace('thickness = "2.5 mm"', 'thickness = "0.004 mm"')), "--force", "5",
+             "--analysis", "linear", "--out", out], "a thin shell needs"),
         # --- report / view / score on run folders
         "report: missing folder": lambda: (["report", str(tmp / "nowhere")], "does not exist"),
         "report: not a run folder": lambda: (["report", str(tmp / "photos")], "incomplete"),
@@ -150,7 +153,7 @@ NAMES = sorted([
     "solve: --out holds other files", "solve: --out is a file", "grasp: unknown scene",
     "grasp: force beyond the gripper", "grasp: negative force", "grasp: NaN force", "grasp: gas on without [gas]",
     "grasp: gas with a linear shell", "grasp: bad E", "grasp: --out holds other files", "object: unknown key",
-    "object: wrong dimension", "object: unknown scene", "report: missing folder", "report: not a run folder",
+    "object: wrong dimension", "object: unknown scene", "grasp: thickness outside the thin-shell range", "report: missing folder", "report: not a run folder",
     "report: bad table file", "view: missing folder", "score: missing prediction", "score: unknown scan id",
     "score: empty scan", "sweep: unknown key", "sweep: force beyond the gripper", "sweep: unreachable scheduler",
     "bench: missing folder"])

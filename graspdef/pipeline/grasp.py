@@ -143,6 +143,7 @@ def prepare_object(scene, analysis: str = "nonlinear", gas: bool | None = None, 
     if analysis == "linear" and p0 > 0:
         raise ProblemError("an enclosed gas needs the nonlinear analysis (p V = const is nonlinear)")
     shell, shell_info = build_shell(spec, analysis)
+    check_thin_shell(spec.thickness, shell.rest_positions[: shell.mesh.n_real], spec.file)
     return GraspObject(xml, spec, shell, shell_info, p0)
 
 
@@ -154,6 +155,27 @@ def check_force(scene, force: float) -> None:
     xml = scene_xml(scene)
     spec = load_object(xml)
     check_targets(load_scene(xml, spec.body), {s: (force if s in spec.fingers else 0.0) for s in ("left", "right")})
+
+
+#: thickness / object size that a Kirchhoff-Love thin shell covers: above 0.2 the object is a thick
+#: solid (transverse shear and thickness change matter); below 1e-4 it is a membrane whose bending
+#: stiffness -- t^3 -- is lost in round-off (0.004 mm on a 65 mm ball gave a 16 m "indentation")
+THIN_SHELL_RANGE = (1e-4, 0.2)
+#: net force of the mapped loads on a free object, relative to the finger force, above which the run
+#: carries a warning (MuJoCo settles the tennis ball to ~1e-5 N)
+EQUILIBRIUM_RTOL = 0.01
+
+
+def check_thin_shell(thickness: float, points: np.ndarray, where) -> None:
+    """Refuse a thickness outside the thin-shell range relative to the object's size (the largest
+    extent of its mid-surface), before any solve."""
+    size = float(np.ptp(points, axis=0).max())
+    ratio = thickness / size
+    lo, hi = THIN_SHELL_RANGE
+    if not lo <= ratio <= hi:
+        raise ProblemError(f"{where}: thickness {thickness * 1e3:.4g} mm is {ratio:.3g} of the object's size "
+                           f"({size * 1e3:.4g} mm); a thin shell needs {lo:g} to {hi:g} of it "
+                           f"({lo * size * 1e3:.3g} to {hi * size * 1e3:.3g} mm here): check the units")
 
 
 def settle(obj: GraspObject, force: float, settings: GraspSettings = GraspSettings()) -> Settled:
@@ -349,6 +371,11 @@ def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solve
             "friction": "MuJoCo's contact forces less their finger-axis parts, as dead loads at the contacts"}
     data["warnings"] = D.plausibility_warnings(analysis, derived["max_displacement"]["value"], spec.thickness,
                                                float(np.ptp(x_lim, axis=0).max()))
+    if free and not fingertips and np.linalg.norm(setup.residual_F) > EQUILIBRIUM_RTOL * force:
+        data["warnings"].append(
+            f"the loads on the free object are not in equilibrium: net force {np.linalg.norm(setup.residual_F):.3g} N "
+            f"(> {EQUILIBRIUM_RTOL:.0%} of the finger force), net moment {np.linalg.norm(setup.residual_M):.3g} N m; "
+            "the rigid-mode support carries it (MuJoCo did not settle: the object slips or rolls)")
     rec = RunRecord("grasp", spec.body, analysis, dict(SI_UNITS), derived, {}, data)
     verts, faces = sol.deformed_surface()
     contacts = {"frame": "world", "units": {"length": "m", "force": "N"}, "object_pose": g.pose.record(),

@@ -62,3 +62,21 @@ def test_open_scan_is_refused(monkeypatch, tmp_path):
     with pytest.raises(MeshError, match="not closed"):
         gp.run_grasp("tennis_ball", 10.0, "point", "linear", out)
     assert not out.exists()
+
+
+def test_stages_alone_and_the_equilibrium_warning():
+    """The chain's stages run one by one (typed inputs and outputs); a free object whose mapped
+    loads do not balance (here: 1 N added to the settled residual of ~1e-5 N) carries a warning
+    with the net force and moment in its record."""
+    from graspdef.pipeline import grasp as gp
+
+    obj = gp.prepare_object("tennis_ball", "linear", control_faces=320)
+    st = gp.settle(obj, 5.0)
+    setup = gp.shell_problem(obj, st, "point")
+    assert setup.free and np.linalg.norm(setup.residual_F) < 1e-3
+    solved = gp.solve_shell(setup, "linear", 4)
+    ok = gp.grasp_record(obj, st, setup, solved, 5.0, "point", "linear", {})
+    assert not [w for w in ok.record["warnings"] if "equilibrium" in w]
+    setup.residual_F = setup.residual_F + np.array([1.0, 0.0, 0.0])
+    bad = gp.grasp_record(obj, st, setup, solved, 5.0, "point", "linear", {})
+    assert [w for w in bad.record["warnings"] if "not in equilibrium: net force 1 N" in w], bad.record["warnings"]
