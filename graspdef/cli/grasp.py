@@ -25,6 +25,48 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--out", required=True, help="run folder to write (replaced if it exists)")
 
 
+class _Progress:
+    """The chain's progress on stderr: its stages, and during the load path one line per converged
+    point (load fraction, Newton iterations, elapsed time), rewritten in place on a terminal."""
+
+    STAGES = {"shell": "building the shell from the object's data", "mujoco": "closing the gripper in MuJoCo",
+              "solve": "solving the shell"}
+
+    def __init__(self, args: argparse.Namespace):
+        import sys
+        import time
+
+        self.args, self.t0, self.tty = args, time.perf_counter(), sys.stderr.isatty()
+        self._open = False
+
+    def __call__(self, stage: str, info: dict | None = None) -> None:
+        import sys
+        import time
+
+        if getattr(self.args, "quiet", False):
+            return
+        t = time.perf_counter() - self.t0
+        if stage != "point":
+            self._end()
+            progress(self.args, f"{self.STAGES.get(stage, stage)} (t = {t:.1f} s)")
+            return
+        bar = "#" * int(20 * min(max(info["load_factor"], 0.0), 1.0))
+        line = (f"[graspdef]   [{bar:<20}] load {100 * info['load_factor']:5.1f} %, {info['iterations']} Newton "
+                f"iterations, {t:.1f} s")
+        if self.tty:
+            print("\r" + line, end="", file=sys.stderr, flush=True)
+            self._open = True
+        else:
+            print(line, file=sys.stderr, flush=True)
+
+    def _end(self) -> None:
+        import sys
+
+        if self._open:
+            print(file=sys.stderr, flush=True)
+            self._open = False
+
+
 def run(a: argparse.Namespace) -> int:
     """Run the chain for parsed arguments; prints two lines (the result, the run folder)."""
     from ..pipeline.grasp import run_grasp
@@ -36,7 +78,9 @@ def run(a: argparse.Namespace) -> int:
     from ..units import quantity
 
     E = None if getattr(a, "E_MPa", None) is None else quantity(a.E_MPa, "pressure", implied="MPa", what="--E-MPa")
-    run = run_grasp(a.scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E)
+    bar = _Progress(a)
+    run = run_grasp(a.scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E, progress=bar)
+    bar._end()                                           # close an open progress line before the summary
     r = run.result
     d = r["derived"]
     ind = d.get("indentation_per_finger", d.get("indentation"))

@@ -77,10 +77,12 @@ def finger_contacts(mapping, g, targets: dict, thickness: float, dhat: float | N
     return loads, fingers
 
 
-def solve_contact(problem, options, linear: bool):
+def solve_contact(problem, options, linear: bool, progress=None):
     """The load path of a problem with finger contacts; ``linear``: the linear shell (rest-state
-    stiffness) instead of the finite-deformation one.  Raises PathStopped like solve_nonlinear."""
-    ps = PathSolver(problem, options, terms=problem.energy_terms("rest" if linear else "finite"))
+    stiffness) instead of the finite-deformation one.  Raises PathStopped like solve_nonlinear.
+    ``progress``: called with each converged point's info (as solve_nonlinear's)."""
+    ps = PathSolver(problem, options, progress=progress,
+                    terms=problem.energy_terms("rest" if linear else "finite"))
     sol = ps.run()
     if not sol.completed:
         raise PathStopped(f"the load path stopped at load factor {sol.load_factor:.6g} after "

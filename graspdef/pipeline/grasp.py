@@ -233,8 +233,10 @@ def shell_problem(obj: GraspObject, st: Settled, contact: str = "point") -> Shel
                       np.cross(shell.rest_positions, fvec).sum(axis=0))
 
 
-def solve_shell(setup: ShellSetup, analysis: str, steps: int) -> Solved:
-    """Stage 4: linear or nonlinear solve; a path that stops is returned as far as it got."""
+def solve_shell(setup: ShellSetup, analysis: str, steps: int, progress=None) -> Solved:
+    """Stage 4: linear or nonlinear solve; a path that stops is returned as far as it got.
+    ``progress``: called with each converged path point's info (load factor, Newton iterations,
+    seconds; graspdef.solve.nonlinear)."""
     fingertips = setup.fingertips
     opt = PathOptions(steps=steps, max_steps=40 * steps, min_step=1e-3, **(CONTACT_PATH if fingertips else {}))
     if analysis == "linear" and not fingertips:
@@ -242,8 +244,8 @@ def solve_shell(setup: ShellSetup, analysis: str, steps: int) -> Solved:
     from .geometric import solve_contact
 
     try:
-        sol = solve_contact(setup.problem, opt, linear=analysis == "linear") if fingertips \
-            else solve_nonlinear(setup.problem, opt)
+        sol = solve_contact(setup.problem, opt, linear=analysis == "linear", progress=progress) if fingertips \
+            else solve_nonlinear(setup.problem, opt, progress=progress)
     except PathStopped as exc:
         return Solved(exc.solution, False, str(exc))
     return Solved(sol, True, None)
@@ -394,9 +396,11 @@ def write_grasp_run(out, outcome: GraspOutcome, config: dict) -> Path:
 
 def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonlinear", out=None,
               gas: bool | None = None, settings: GraspSettings = GraspSettings(), control_faces: int | None = None,
-              steps: int | None = None, E: float | None = None) -> GraspRun:
+              steps: int | None = None, E: float | None = None, progress=None) -> GraspRun:
     """Run the whole chain for ``scene`` at ``force`` [N] per finger; write the run folder ``out``
-    (when given) and return its record (see the stages above for the arguments)."""
+    (when given) and return its record (see the stages above for the arguments; ``progress``:
+    called with a stage name and, during the path, each converged point's info)."""
+    say = progress or (lambda stage, info=None: None)
     t0 = time.perf_counter()
     if contact not in ("point", "geometric"):
         raise ProblemError(f"contact must be 'point' (the paper's point loads) or 'geometric' (rigid fingertips), "
@@ -404,12 +408,15 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     if not np.isfinite(force) or force <= 0:
         raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
     check_force(scene, force)                 # the gripper's range, before the shell is built
+    say("shell")
     obj = prepare_object(scene, analysis, gas, control_faces, E)
     t_shell = time.perf_counter()
+    say("mujoco")
     st = settle(obj, force, settings)
     t_sim = time.perf_counter()
     setup = shell_problem(obj, st, contact)
-    solved = solve_shell(setup, analysis, steps or obj.spec.steps)
+    say("solve")
+    solved = solve_shell(setup, analysis, steps or obj.spec.steps, progress=lambda info: say("point", info))
     t_solve = time.perf_counter()
     timings = {"shell_setup": t_shell - t0, "mujoco": t_sim - t_shell, "solve": t_solve - t_sim}
     outcome = grasp_record(obj, st, setup, solved, force, contact, analysis, timings)
