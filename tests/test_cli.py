@@ -246,3 +246,16 @@ def test_object_show_prints_what_a_grasp_uses(capsys):
     assert main(["object", "show", "no_such_object"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "scene not found" in err[0]
+
+
+def test_fingertips_pick_the_scene_variant():
+    """``--fingertips pad`` grips with the scene folder's rubber pads (scene_pad.xml), ``pin`` with
+    its pins (scene.xml); an unknown variant is refused by name."""
+    from graspdef.errors import ProblemError
+    from graspdef.objects import scene_xml
+
+    assert scene_xml("tennis_ball", "pad").name == "scene_pad.xml"
+    assert scene_xml("tennis_ball", "pin").name == "scene.xml"
+    assert scene_xml(scene_xml("tennis_ball"), "pad").name == "scene_pad.xml"
+    with pytest.raises(ProblemError, match="accepted: pin, pad"):
+        scene_xml("tennis_ball", "claw")

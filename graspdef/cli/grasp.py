@@ -17,6 +17,9 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="point loads (the paper's model) or geometric: the fingertips as rigid, force-controlled, "
                          "penetration-free obstacles (contact area grows with the load)")
     ap.add_argument("--analysis", choices=["linear", "nonlinear"], default="nonlinear")
+    ap.add_argument("--fingertips", choices=["pin", "pad"],
+                    help="the scene folder's gripper variant: pin (scene.xml) or pad (scene_pad.xml, rubber pads); "
+                         "default: the scene given")
     ap.add_argument("--gas", choices=["auto", "on", "off"], default="auto",
                     help="enclosed air: auto = object.toml's [gas] (nonlinear only), on (object.toml's [gas] p0; "
                          "an error if it has none), off")
@@ -79,7 +82,12 @@ def run(a: argparse.Namespace) -> int:
 
     E = None if getattr(a, "E_MPa", None) is None else quantity(a.E_MPa, "pressure", implied="MPa", what="--E-MPa")
     bar = _Progress(a)
-    run = run_grasp(a.scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E, progress=bar)
+    scene = a.scene
+    if getattr(a, "fingertips", None):
+        from ..objects import scene_xml
+
+        scene = scene_xml(a.scene, a.fingertips)
+    run = run_grasp(scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E, progress=bar)
     bar._end()                                           # close an open progress line before the summary
     r = run.result
     d = r["derived"]

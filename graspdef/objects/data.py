@@ -213,14 +213,27 @@ class ObjectSpec:
         return dataclasses.replace(self, **changes)
 
 
-def scene_xml(scene) -> Path:
-    """A scene folder, its scene*.xml, or a name under scenes/ -> the scene XML path."""
+#: fingertip variants of a scene folder: the scene file that grips the object with them
+FINGERTIPS = {"pin": "scene.xml", "pad": "scene_pad.xml"}
+
+
+def scene_xml(scene, fingertips: str | None = None) -> Path:
+    """A scene folder, its scene*.xml, or a name under scenes/ -> the scene XML path;
+    ``fingertips`` ("pin" or "pad") picks the folder's scene with those fingertips."""
+    if fingertips is not None and fingertips not in FINGERTIPS:
+        raise ProblemError(f"unknown fingertips {fingertips!r}; accepted: {', '.join(FINGERTIPS)}")
+    name = FINGERTIPS[fingertips or "pin"]
     p = Path(scene)
     if p.is_dir():
-        p = p / "scene.xml"
+        p = p / name
     elif not p.exists() and (SCENES / str(scene)).is_dir():
-        p = SCENES / str(scene) / "scene.xml"
+        p = SCENES / str(scene) / name
+    elif fingertips is not None and p.is_file():
+        p = p.parent / name
     if not p.is_file():
+        if fingertips is not None and p.parent.is_dir():
+            raise ProblemError(f"scene {scene}: no {name} for {fingertips} fingertips in {p.parent} "
+                               f"(has: {', '.join(sorted(q.name for q in p.parent.glob('scene*.xml'))) or 'none'})")
         raise ProblemError(f"scene not found: {scene} (give a scene.xml, its folder, or a name in {SCENES})")
     return p
 
