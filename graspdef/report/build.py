@@ -473,7 +473,9 @@ def build_report(run_dirs, out: str | PathLike | None = None, *, scan: str | Non
         f"<a href=\"#run-{i}\">{H.esc(rr.run.label)}</a>" for i, rr in enumerate(runs))
         + "</p>"]
     rows = table_rows(runs)
-    if any(r["measured_mm"] is not None or ("nonlinear" in r and "linear" in r) for r in rows) or len(rows) > 1:
+    # measured vs predicted only where a measurement exists (the paper's for the tennis ball, or a
+    # table file's); runs of an object nobody measured get no comparison table
+    if any(r["measured_mm"] is not None for r in rows):
         body[0] = body[0].replace("</p>", ", <a href=\"#table-i\">Table I</a></p>")
         body += _table_section(rows)
     for i, rr in enumerate(runs):

@@ -178,3 +178,15 @@ def test_a_stopped_path_is_marked_and_gets_no_error(cantilever_run, tmp_path):
     cells = re.findall(r"<td[^>]*>(.*?)</td>", row)
     assert "path stopped at load factor 0.5" in cells[2] and cells[3] == "&ndash;"
     assert "Newton did not converge (test)" in text and "the load path stopped" in text
+
+
+def test_no_measurement_no_comparison_table(ball_run, tmp_path):
+    """Measured vs predicted appears only where a measurement exists: the same run listed at a
+    force the paper did not measure (and no measured_mm) gets no Table I; with a measured value
+    in the table file it does."""
+    (tmp_path / "runs.csv").write_text(f"run,force_N\n{ball_run},7.0\n{ball_run},8.0\n")
+    text = build_report([], tmp_path / "t.html", table=tmp_path / "runs.csv").read_text()
+    assert "table-i-table" not in text and "Table I" not in text
+    (tmp_path / "runs.csv").write_text(f"run,force_N,measured_mm\n{ball_run},7.0,1.5\n{ball_run},8.0,\n")
+    text = build_report([], tmp_path / "t2.html", table=tmp_path / "runs.csv").read_text()
+    assert "table-i-table" in text
