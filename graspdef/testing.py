@@ -59,3 +59,37 @@ def headless_chromium(profile_dir, window: str = "1200,800"):
     driver = webdriver.Chrome(options=opts, service=Service(chromedriver))
     driver.set_page_load_timeout(60)
     return driver
+
+
+# ---- small problem files the tests share (one text each, not a copy per test module) -------------
+POINT_LOAD = 'kind = "point"\nat = [0.0, 0.0, 0.0]\nforce = [0.0, 0.0, -1.0]'
+
+
+def plate_problem(name: str = "small_plate", n: int = 4, load: str = POINT_LOAD, probe: bool = True) -> str:
+    """Problem-file text: a 100 mm square plate (mm, N; E = 1000 N/mm^2, nu = 0.3, t = 1 mm),
+    simply supported, ``n`` x ``n`` cells, one load table (default: 1 N down at the centre) and a
+    probe "centre"."""
+    text = (f'\nname = "{name}"\n[units]\nlength = "mm"\nforce = "N"\n[geometry]\ntype = "rectangle"\n'
+            f"lx = 100.0\nly = 100.0\nnx = {n}\nny = {n}\n[material]\nE = 1000.0\nnu = 0.3\n[shell]\n"
+            'thickness = 1.0\n[regions]\nedges = "abs(abs(x) - 50) < 1e-6 or abs(abs(y) - 50) < 1e-6"\n'
+            '[[supports]]\nkind = "simply_supported"\nregion = "edges"\n'
+            f"[[loads]]\n{load}\n")
+    return text + ('[[probes]]\nname = "centre"\nat = [0.0, 0.0, 0.0]\n' if probe else "")
+
+
+def cantilever_problem(name: str = "cantilever_small", nx: int = 10, force: float = 1.0, steps: int = 4,
+                       units: str = "consistent", length: float = 10.0, width: float = 1.0, E: float = 1.2e6,
+                       thickness: float = 0.1) -> str:
+    """Problem-file text: a Saint Venant-Kirchhoff cantilever strip (nu = 0) clamped at x = 0,
+    an edge load ``force`` (total, +z) at the tip, probe "tip", a load-controlled nonlinear path of
+    ``steps`` steps; ``units`` "consistent" or "mm" (then forces in N)."""
+    force_unit = "consistent" if units == "consistent" else "N"
+    return (f'\nname = "{name}"\n[units]\nlength = "{units}"\nforce = "{force_unit}"\n[geometry]\n'
+            f'type = "rectangle"\nlx = {length!r}\nly = {width!r}\nnx = {nx}\nny = 2\n'
+            f"center = [{length / 2!r}, {width / 2!r}]\n"
+            f'[material]\nmodel = "saint_venant_kirchhoff"\nE = {E!r}\nnu = 0.0\n[shell]\nthickness = {thickness!r}\n'
+            f'[regions]\nroot = "abs(x) < 1e-9"\ntip = "abs(x - {length!r}) < 1e-9"\n'
+            '[[supports]]\nkind = "clamped"\nregion = "root"\n'
+            f'[[loads]]\nkind = "edge_load"\nregion = "tip"\nforce = [0.0, 0.0, {force!r}]\n'
+            f'[[probes]]\nname = "tip"\nat = [{length!r}, {width / 2!r}, 0.0]\n'
+            f'[solver]\ntype = "nonlinear"\nmethod = "load"\nsteps = {steps}\n')

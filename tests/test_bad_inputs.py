@@ -10,35 +10,11 @@ from pathlib import Path
 import pytest
 
 from graspdef.cli import main
+from graspdef.testing import plate_problem
 
 REPO = Path(__file__).resolve().parents[1]
 
-PLATE = """
-name = "plate"
-[units]
-length = "mm"
-force = "N"
-[geometry]
-type = "rectangle"
-lx = 100.0
-ly = 100.0
-nx = 4
-ny = 4
-[material]
-E = 1000.0
-nu = 0.3
-[shell]
-thickness = 1.0
-[regions]
-edges = "abs(abs(x) - 50) < 1e-6 or abs(abs(y) - 50) < 1e-6"
-[[supports]]
-kind = "simply_supported"
-region = "edges"
-[[loads]]
-kind = "point"
-at = [0.0, 0.0, 0.0]
-force = [0.0, 0.0, -1.0]
-"""
+PLATE = plate_problem("plate", 4, probe=False)
 
 TRI = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
 

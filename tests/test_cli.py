@@ -7,36 +7,9 @@ import numpy as np
 import pytest
 
 from graspdef.cli import main
+from graspdef.testing import plate_problem
 
-BASE = """
-name = "small_plate"
-[units]
-length = "mm"
-force = "N"
-[geometry]
-type = "rectangle"
-lx = 100.0
-ly = 100.0
-nx = 6
-ny = 6
-[material]
-E = 1000.0
-nu = 0.3
-[shell]
-thickness = 1.0
-[regions]
-edges = "abs(abs(x) - 50) < 1e-6 or abs(abs(y) - 50) < 1e-6"
-[[supports]]
-kind = "simply_supported"
-region = "edges"
-[[loads]]
-kind = "point"
-at = [0.0, 0.0, 0.0]
-force = [0.0, 0.0, -1.0]
-[[probes]]
-name = "centre"
-at = [0.0, 0.0, 0.0]
-"""
+BASE = plate_problem("small_plate", 6)
 
 
 def _run(tmp_path: Path, text: str, capsys, name="p.toml"):

@@ -4,35 +4,9 @@ import pytest
 
 from graspdef.errors import ProblemError
 from graspdef.problem.config import load_problem
+from graspdef.testing import plate_problem
 
-BASE = """
-name = "small_plate"
-[units]
-length = "mm"
-force = "N"
-[geometry]
-type = "rectangle"
-lx = 100.0
-ly = 100.0
-nx = 4
-ny = 4
-[material]
-E = 1000.0
-nu = 0.3
-[shell]
-thickness = 1.0
-[regions]
-edges = "abs(abs(x) - 50) < 1e-6 or abs(abs(y) - 50) < 1e-6"
-[[supports]]
-kind = "simply_supported"
-region = "edges"
-[[loads]]
-kind = "pressure"
-p = 0.01
-[[probes]]
-name = "centre"
-at = [0.0, 0.0, 0.0]
-"""
+BASE = plate_problem("small_plate", 4, load='kind = "pressure"\np = 0.01')
 
 
 def _load(tmp_path, text):

@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from graspdef.testing import cantilever_problem
+
 BALL_MM = """
 name = "ball_mm"
 [units]
@@ -37,42 +39,7 @@ name = "top"
 at = [0.0, 0.0, 32.5]
 """
 
-CANTILEVER = """
-name = "cantilever_small"
-[units]
-length = "consistent"
-force = "consistent"
-[geometry]
-type = "rectangle"
-lx = 10.0
-ly = 1.0
-nx = 6
-ny = 2
-center = [5.0, 0.5]
-[material]
-model = "saint_venant_kirchhoff"
-E = 1.2e6
-nu = 0.0
-[shell]
-thickness = 0.1
-[regions]
-root = "abs(x) < 1e-9"
-tip = "abs(x - 10) < 1e-9"
-[[supports]]
-kind = "clamped"
-region = "root"
-[[loads]]
-kind = "edge_load"
-region = "tip"
-force = [0.0, 0.0, 0.1]
-[[probes]]
-name = "tip"
-at = [10.0, 0.5, 0.0]
-[solver]
-type = "nonlinear"
-method = "load"
-steps = 3
-"""
+CANTILEVER = cantilever_problem(nx=6, force=0.1, steps=3)
 
 
 def solve_into(folder: Path, text: str) -> Path:

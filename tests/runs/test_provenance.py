@@ -2,34 +2,14 @@
 import json
 
 from graspdef.cli import main
-from graspdef.runs.provenance import provenance_record, read_provenance, write_provenance
+from graspdef.runs.provenance import (
+    provenance_record,
+    read_provenance,
+    write_provenance,
+)
+from graspdef.testing import plate_problem
 
-PLATE = """
-name = "tiny_plate"
-[units]
-length = "mm"
-force = "N"
-[geometry]
-type = "rectangle"
-lx = 100.0
-ly = 100.0
-nx = 4
-ny = 4
-[material]
-E = 1000.0
-nu = 0.3
-[shell]
-thickness = 1.0
-[regions]
-edges = "abs(abs(x) - 50) < 1e-6 or abs(abs(y) - 50) < 1e-6"
-[[supports]]
-kind = "simply_supported"
-region = "edges"
-[[loads]]
-kind = "point"
-at = [0.0, 0.0, 0.0]
-force = [0.0, 0.0, -1.0]
-"""
+PLATE = plate_problem("tiny_plate", 4, probe=False)
 
 
 def test_record_has_versions_command_and_config(tmp_path):

@@ -20,44 +20,11 @@ from graspdef.cli import main
 from graspdef.errors import GraspdefError
 from graspdef.runs.read import read_run
 from graspdef.runs.record import SCHEMA_VERSION, RunFolderError, RunRecord
+from graspdef.testing import cantilever_problem
 
 #: a small nonlinear cantilever in mm and N (physical units: it can be scored against a scan)
-CANTILEVER_MM = """
-name = "cantilever_mm"
-[units]
-length = "mm"
-force = "N"
-[geometry]
-type = "rectangle"
-lx = 100.0
-ly = 10.0
-nx = 8
-ny = 2
-center = [50.0, 5.0]
-[material]
-model = "saint_venant_kirchhoff"
-E = 2000.0
-nu = 0.0
-[shell]
-thickness = 1.0
-[regions]
-root = "abs(x) < 1e-9"
-tip = "abs(x - 100) < 1e-9"
-[[supports]]
-kind = "clamped"
-region = "root"
-[[loads]]
-kind = "edge_load"
-region = "tip"
-force = [0.0, 0.0, 0.02]
-[[probes]]
-name = "tip"
-at = [100.0, 5.0, 0.0]
-[solver]
-type = "nonlinear"
-method = "load"
-steps = 3
-"""
+CANTILEVER_MM = cantilever_problem("cantilever_mm", nx=8, force=0.02, steps=3, units="mm", length=100.0, width=10.0,
+                                   E=2000.0, thickness=1.0)
 
 CONTACTS = {"units": {"length": "mm", "force": "N"},
             "fingers": [{"name": "pad", "position": [100, 5, 3], "size": [5, 5, 5]}],

@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from graspdef.testing import cantilever_problem
+
 PLATE_MM = """
 name = "plate_mm"
 [units]
@@ -38,42 +40,7 @@ name = "centre"
 at = [0.0, 0.0, 0.0]
 """
 
-CANTILEVER = """
-name = "cantilever_small"
-[units]
-length = "consistent"
-force = "consistent"
-[geometry]
-type = "rectangle"
-lx = 10.0
-ly = 1.0
-nx = 10
-ny = 2
-center = [5.0, 0.5]
-[material]
-model = "saint_venant_kirchhoff"
-E = 1.2e6
-nu = 0.0
-[shell]
-thickness = 0.1
-[regions]
-root = "abs(x) < 1e-9"
-tip = "abs(x - 10) < 1e-9"
-[[supports]]
-kind = "clamped"
-region = "root"
-[[loads]]
-kind = "edge_load"
-region = "tip"
-force = [0.0, 0.0, 1.0]
-[[probes]]
-name = "tip"
-at = [10.0, 0.5, 0.0]
-[solver]
-type = "nonlinear"
-method = "load"
-steps = 4
-"""
+CANTILEVER = cantilever_problem()
 
 
 def _solve(folder: Path, text: str, path_u: bool = True) -> Path:
