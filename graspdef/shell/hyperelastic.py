@@ -485,6 +485,16 @@ class Exponential(_Incompressible):
 # ------------------------------------------------------------------------------------------------
 # compressible neo-Hookean: C33 from plane stress
 # ------------------------------------------------------------------------------------------------
+def _lame(E: float, nu: float, law: str, incompressible: str) -> tuple[float, float]:
+    """Lame parameters (mu, lam) [Pa] of a compressible law from E [Pa] > 0 and 0 <= nu < 1/2."""
+    E = _positive(f"{law} Young's modulus E", E)
+    nu = _number(f"{law} Poisson's ratio nu", nu)
+    if not 0.0 <= nu < 0.5:
+        raise ProblemError(f"{law} Poisson's ratio nu must lie in [0, 0.5), got {nu!r} "
+                           f"(nu = 0.5 is incompressible: use {incompressible})")
+    return E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+
+
 @dataclass(frozen=True)
 class CompressibleNeoHookean(_ThicknessIntegrated):
     """Compressible neo-Hookean shell material with a plane-stress through-thickness stretch.
@@ -519,14 +529,8 @@ class CompressibleNeoHookean(_ThicknessIntegrated):
     @classmethod
     def from_E_nu(cls, E: float, nu: float, n_thickness: int = 3) -> "CompressibleNeoHookean":
         """From Young's modulus E [Pa] > 0 and Poisson's ratio 0 <= nu < 1/2 [-]."""
-        E = _positive("compressible neo-Hookean Young's modulus E", E)
-        nu = _number("compressible neo-Hookean Poisson's ratio nu", nu)
-        if not 0.0 <= nu < 0.5:
-            raise ProblemError(
-                f"compressible neo-Hookean Poisson's ratio nu must lie in [0, 0.5), got {nu!r} "
-                f"(nu = 0.5 is incompressible: use neo_hookean)")
-        return cls(mu=E / (2.0 * (1.0 + nu)), lam=E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
-                   n_thickness=n_thickness)
+        mu, lam = _lame(E, nu, "compressible neo-Hookean", "neo_hookean")
+        return cls(mu=mu, lam=lam, n_thickness=n_thickness)
 
     @property
     def E(self) -> float:
@@ -632,16 +636,10 @@ class CompressibleMooneyRivlin(_ThicknessIntegrated):
     def from_E_nu(cls, E: float, nu: float, c2_over_c1: float, n_thickness: int = 3) -> "CompressibleMooneyRivlin":
         """From the small-strain Young's modulus E [Pa] > 0, Poisson's ratio 0 <= nu < 1/2 and the
         ratio C2/C1 >= 0: mu = E / (2 (1 + nu)) = 2 (C1 + C2), lam = E nu / ((1 + nu)(1 - 2 nu))."""
-        E = _positive("compressible Mooney-Rivlin Young's modulus E", E)
-        nu = _number("compressible Mooney-Rivlin Poisson's ratio nu", nu)
+        mu, lam = _lame(E, nu, "compressible Mooney-Rivlin", "mooney_rivlin")
         r = _non_negative("compressible Mooney-Rivlin ratio C2/C1", c2_over_c1)
-        if not 0.0 <= nu < 0.5:
-            raise ProblemError(
-                f"compressible Mooney-Rivlin Poisson's ratio nu must lie in [0, 0.5), got {nu!r} "
-                f"(nu = 0.5 is incompressible: use mooney_rivlin)")
-        mu = E / (2.0 * (1.0 + nu))
         c1 = mu / (2.0 * (1.0 + r))
-        return cls(C1=c1, C2=r * c1, lam=E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), n_thickness=n_thickness)
+        return cls(C1=c1, C2=r * c1, lam=lam, n_thickness=n_thickness)
 
     @property
     def mu(self) -> float:
