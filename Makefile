@@ -27,7 +27,7 @@ $(STAMP): pyproject.toml
 	@echo "setting up $(VENV) (log: $(SETUP_LOG)) ..."
 	@$(PYTHON) -m venv $(VENV)
 	@( $(PY) -m pip install --upgrade pip && \
-	   $(PY) -m pip install -e ".[dev,bench,register,viewer,sim,sweep]" ) > $(SETUP_LOG) 2>&1 \
+	   $(PY) -m pip install -e ".[dev,bench,register,viewer,sim,sweep,objects]" ) > $(SETUP_LOG) 2>&1 \
 	  || { tail -n 40 $(SETUP_LOG); echo "set-up failed: the whole log is $(SETUP_LOG)"; exit 1; }
 	@touch $(STAMP)
 	@echo "set-up done"

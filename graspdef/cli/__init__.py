@@ -10,6 +10,7 @@ arguments into typed inputs and calls a library function.
     graspdef report RUN_DIR [RUN_DIR ...] [--scan SCAN] [--out FILE]   self-contained HTML report
     graspdef sweep SPEC.toml --out DIR [--workers N | --scheduler tcp://HOST:PORT]   a grid of grasps
     graspdef object show SCENE                 what a grasp of this object will use (law, E, nu, gas)
+    graspdef object add NAME --mesh FILE ...   a mesh of your own -> an object folder to grasp
 
 Every error a user can cause prints one line ``graspdef: error: ...`` and exits with status 2.
 Building the parser imports no numerical package (``graspdef --help`` stays fast).

@@ -20,6 +20,10 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--fingertips", choices=["pin", "pad"],
                     help="the scene folder's gripper variant: pin (scene.xml) or pad (scene_pad.xml, rubber pads); "
                          "default: the scene given")
+    ap.add_argument("--pad-size", help="this run's pad edge, e.g. 30mm (pad fingertips; the scene's: 24 mm)")
+    ap.add_argument("--tip-material", choices=["rubber", "steel"],
+                    help="this run's fingertip material: its friction and contact stiffness "
+                         "(the scene's: steel pins, rubber pads)")
     ap.add_argument("--gas", choices=["auto", "on", "off"], default="auto",
                     help="enclosed air: auto = object.toml's [gas] (nonlinear only), on (object.toml's [gas] p0; "
                          "an error if it has none), off")
@@ -87,7 +91,13 @@ def run(a: argparse.Namespace) -> int:
         from ..objects import scene_xml
 
         scene = scene_xml(a.scene, a.fingertips)
-    run = run_grasp(scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E, progress=bar)
+    tips = None
+    if getattr(a, "pad_size", None) is not None or getattr(a, "tip_material", None) is not None:
+        from ..sim.gripper import FingertipChange
+
+        tips = FingertipChange(None if a.pad_size is None else quantity(a.pad_size, "length", what="--pad-size"),
+                               a.tip_material)
+    run = run_grasp(scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E, progress=bar, fingertips=tips)
     bar._end()                                           # close an open progress line before the summary
     r = run.result
     d = r["derived"]

@@ -5,12 +5,15 @@ The file states everything the shell model of a grasped object needs, with units
     [object]
     body = "tennis_ball"                 # body name in the scene's MJCF
     scan = "ycb_056_tennis_ball"         # scans/manifest.toml id: the outer surface
+    # or, for an object of one's own (graspdef object add): the control mesh itself
+    # control_mesh = "control_mesh.ply"  # outer surface, a Loop control mesh; PLY 'comment units m'
+    # surface = "surface.ply"            # optional: the input surface it was made from (reference)
 
     [shell]
     thickness = "2.5 mm"
     source = "Tian & Jia 2010, Sec. IX-A"          # optional
     control_faces = 1280                 # optional (1280): faces of the control mesh
-    remesh = "project"                   # optional (auto): auto | project | decimate
+    remesh = "project"                   # optional (auto): auto | project | decimate | isotropic
     relax = 0                            # optional (0): tangential smoothing steps on the scan
 
     [material]
@@ -64,7 +67,7 @@ SCENES = Path(__file__).resolve().parents[2] / "scenes"
 OBJECT_FILE = "object.toml"
 #: material laws of object data
 LAWS = ("neo_hookean", "mooney_rivlin", "svk", "linear")
-REMESH = ("auto", "project", "decimate")
+REMESH = ("auto", "project", "decimate", "isotropic")
 
 _TABLES = {"object", "shell", "material", "gas", "grasp", "supports", "solver"}
 _MATERIAL_KEYS = {"law", "E", "nu", "source", "C1", "C2", "C2_over_C1"}
@@ -164,8 +167,9 @@ class ObjectSpec:
         The scene XML (MuJoCo) the object is grasped in.
     body : str
         The object's body name in the scene.
-    scan : str
-        Real scan id of ``scans/manifest.toml`` (the outer surface).
+    scan : str or None
+        Real scan id of ``scans/manifest.toml`` (the outer surface), or None when the object
+        gives its control mesh.
     thickness : float
         Wall thickness [m].
     control_faces, remesh, relax :
@@ -178,12 +182,16 @@ class ObjectSpec:
         Points [m, object frame] held when the body is fixed in the scene.
     steps : int
         Initial load steps of a nonlinear path.
+    control_mesh : Path or None
+        The outer surface as a ready Loop control mesh (graspdef object add), instead of a scan.
+    surface : Path or None
+        The input surface the control mesh was made from (a reference; not used by the solve).
     """
 
     file: Path
     scene: Path
     body: str
-    scan: str
+    scan: str | None
     thickness: float
     control_faces: int
     remesh: str
@@ -193,6 +201,8 @@ class ObjectSpec:
     fingers: tuple[str, ...]
     fixed_points: tuple[tuple[float, float, float], ...]
     steps: int
+    control_mesh: Path | None = None
+    surface: Path | None = None
 
     @property
     def folder(self) -> Path:
@@ -282,8 +292,18 @@ def read_object(path, scene=None) -> ObjectSpec:
 
     path = Path(path)
     doc = read_toml(path, "object file").check(_TABLES, ("object", "shell", "material"))
-    o = doc.table("object").check({"body", "scan"}, ("body", "scan"))
-    scan = o.string("scan", choices=load_manifest().real)
+    o = doc.table("object").check({"body", "scan", "control_mesh", "surface"}, ("body",))
+    if ("scan" in o) == ("control_mesh" in o):
+        raise o.error("give scan (a scans/manifest.toml id) or control_mesh (a PLY file beside object.toml), "
+                      "one of them")
+    scan = o.string("scan", choices=load_manifest().real) if "scan" in o else None
+    files = {}
+    for key in ("control_mesh", "surface"):
+        if key in o:
+            f = path.parent / o.string(key)
+            if not f.is_file():
+                raise ConfigError(f"{o.where(key)}: file not found: {f}")
+            files[key] = f
     sh = doc.table("shell").check({"thickness", "source", "control_faces", "remesh", "relax"}, ("thickness",))
     thickness = sh.quantity("thickness", "length", positive=True)
     sh.string("source", "")
@@ -304,4 +324,4 @@ def read_object(path, scene=None) -> ObjectSpec:
     return ObjectSpec(path, Path(scene) if scene is not None else path.parent / "scene.xml", o.string("body"), scan,
                       thickness, sh.integer("control_faces", 1280, minimum=20), sh.string("remesh", "auto", choices=REMESH),
                       sh.integer("relax", 0, minimum=0), material, gas, fingers, fixed,
-                      solver.integer("steps", 8, positive=True))
+                      solver.integer("steps", 8, positive=True), files.get("control_mesh"), files.get("surface"))

@@ -38,6 +38,7 @@ from ..contact.barrier import CONTACT_PATH
 from ..contact.mapping import map_contacts
 from ..errors import ProblemError
 from ..objects import build_shell, load_object, scene_xml
+from ..objects.checks import check_thin_shell
 from ..problem.loads import BodyForce
 from ..problem.potentials import EnclosedGas
 from ..problem.problem import Problem
@@ -128,6 +129,9 @@ def prepare_object(scene, analysis: str = "nonlinear", gas: bool | None = None, 
     xml = scene_xml(scene)
     spec = load_object(xml)
     if control_faces:
+        if spec.control_mesh is not None:
+            raise ProblemError(f"{spec.file}: the object gives its own control mesh ({spec.control_mesh.name}); "
+                               "a different size is made with graspdef object add --faces")
         spec = spec.replace(control_faces=int(control_faces))
     if E is not None:
         if not (np.isfinite(E) and E > 0):
@@ -147,43 +151,28 @@ def prepare_object(scene, analysis: str = "nonlinear", gas: bool | None = None, 
     return GraspObject(xml, spec, shell, shell_info, p0)
 
 
-def check_force(scene, force: float) -> None:
+def check_force(scene, force: float, fingertips=None) -> None:
     """Refuse, before any heavy work, a per-finger force outside the scene's gripper range."""
     from ..sim.grasp import check_targets
     from ..sim.scene import load_scene
 
     xml = scene_xml(scene)
     spec = load_object(xml)
-    check_targets(load_scene(xml, spec.body), {s: (force if s in spec.fingers else 0.0) for s in ("left", "right")})
+    check_targets(load_scene(xml, spec.body, fingertips), {s: (force if s in spec.fingers else 0.0) for s in ("left", "right")})
 
 
-#: thickness / object size that a Kirchhoff-Love thin shell covers: above 0.2 the object is a thick
-#: solid (transverse shear and thickness change matter); below 1e-4 it is a membrane whose bending
-#: stiffness -- t^3 -- is lost in round-off (0.004 mm on a 65 mm ball gave a 16 m "indentation")
-THIN_SHELL_RANGE = (1e-4, 0.2)
 #: net force of the mapped loads on a free object, relative to the finger force, above which the run
 #: carries a warning (MuJoCo settles the tennis ball to ~1e-5 N)
 EQUILIBRIUM_RTOL = 0.01
 
 
-def check_thin_shell(thickness: float, points: np.ndarray, where) -> None:
-    """Refuse a thickness outside the thin-shell range relative to the object's size (the largest
-    extent of its mid-surface), before any solve."""
-    size = float(np.ptp(points, axis=0).max())
-    ratio = thickness / size
-    lo, hi = THIN_SHELL_RANGE
-    if not lo <= ratio <= hi:
-        raise ProblemError(f"{where}: thickness {thickness * 1e3:.4g} mm is {ratio:.3g} of the object's size "
-                           f"({size * 1e3:.4g} mm); a thin shell needs {lo:g} to {hi:g} of it "
-                           f"({lo * size * 1e3:.3g} to {hi * size * 1e3:.3g} mm here): check the units")
-
-
-def settle(obj: GraspObject, force: float, settings: GraspSettings = GraspSettings()) -> Settled:
-    """Stage 2: close the gripper to ``force`` [N] per finger in MuJoCo and settle."""
+def settle(obj: GraspObject, force: float, settings: GraspSettings = GraspSettings(), fingertips=None) -> Settled:
+    """Stage 2: close the gripper to ``force`` [N] per finger in MuJoCo and settle (``fingertips``:
+    a per-run graspdef.sim.gripper.FingertipChange: pad size, material)."""
     if not np.isfinite(force) or force <= 0:
         raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
     targets = {s: (force if s in obj.spec.fingers else 0.0) for s in ("left", "right")}
-    return Settled(grasp(obj.xml, targets, obj.spec.body, settings), targets)
+    return Settled(grasp(obj.xml, targets, obj.spec.body, settings, fingertips), targets)
 
 
 def shell_problem(obj: GraspObject, st: Settled, contact: str = "point") -> ShellSetup:
@@ -396,10 +385,11 @@ def write_grasp_run(out, outcome: GraspOutcome, config: dict) -> Path:
 
 def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonlinear", out=None,
               gas: bool | None = None, settings: GraspSettings = GraspSettings(), control_faces: int | None = None,
-              steps: int | None = None, E: float | None = None, progress=None) -> GraspRun:
+              steps: int | None = None, E: float | None = None, progress=None, fingertips=None) -> GraspRun:
     """Run the whole chain for ``scene`` at ``force`` [N] per finger; write the run folder ``out``
     (when given) and return its record (see the stages above for the arguments; ``progress``:
-    called with a stage name and, during the path, each converged point's info)."""
+    called with a stage name and, during the path, each converged point's info; ``fingertips``: a
+    graspdef.sim.gripper.FingertipChange for this run)."""
     say = progress or (lambda stage, info=None: None)
     t0 = time.perf_counter()
     if contact not in ("point", "geometric"):
@@ -407,12 +397,12 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
                            f"got {contact!r}")
     if not np.isfinite(force) or force <= 0:
         raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
-    check_force(scene, force)                 # the gripper's range, before the shell is built
+    check_force(scene, force, fingertips)     # the gripper's range, before the shell is built
     say("shell")
     obj = prepare_object(scene, analysis, gas, control_faces, E)
     t_shell = time.perf_counter()
     say("mujoco")
-    st = settle(obj, force, settings)
+    st = settle(obj, force, settings, fingertips)
     t_sim = time.perf_counter()
     setup = shell_problem(obj, st, contact)
     say("solve")
@@ -424,6 +414,7 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     if out is not None:
         config = {"scene": str(scene), "force_N": force, "contact": contact, "analysis": analysis, "gas": gas,
                   "control_faces": control_faces, "steps": steps, "E_Pa": E, "settings": dict(settings.__dict__),
+                  "fingertips": None if fingertips is None else dict(fingertips.__dict__),
                   "object_toml": obj.spec.file.read_text()}
         out = write_grasp_run(out, outcome, config)
     return GraspRun(Path(out) if out is not None else None, outcome.record.to_json())

@@ -23,6 +23,7 @@ from ..geometry import io as gio
 from ..geometry import primitives as prim
 from ..geometry.regions import compile_predicate
 from ..shell.hyperelastic import MATERIALS, PARAMETERS, make_material
+from ..shell.memory import check_memory
 from ..shell.model import Shell
 from ..units import FORCE_UNITS  # noqa: F401  (re-exported: the unit tables live in graspdef.units)
 from .loads import BodyForce, EdgeLoad, PointLoad, Pressure
@@ -152,6 +153,9 @@ def _geometry(g: Table, units: FileUnits, base: Path):
             args[k] = units.quantity(g, k, "length")
         else:
             args[k] = g.number(k)
+    n_est = _vertex_count(kind, args)
+    if n_est is not None:                 # before the mesh is generated: a huge one would exhaust memory
+        check_memory(n_est, f"{g.where()}: this {kind}")
     if kind == "monkey_saddle":   # x^3 - 3 x y^2 = scale z, scale in length^2 (one factor above)
         hw = args.pop("half_width")
         scale = args.pop("scale", 5000.0 * ls) * ls
@@ -159,6 +163,19 @@ def _geometry(g: Table, units: FileUnits, base: Path):
     if kind == "sphere":
         return prim.icosphere(**args)
     return getattr(prim, kind)(**args)
+
+
+def _vertex_count(kind: str, args: dict) -> int | None:
+    """The control-vertex count of a generated geometry, known before it is generated."""
+    if kind in ("sphere", "ellipsoid"):
+        return 10 * 4 ** max(0, min(int(args.get("subdivisions", 0)), 30)) + 2
+    if kind == "rectangle":
+        return (args["nx"] + 1) * (args["ny"] + 1)
+    if kind in ("square_plate", "monkey_saddle"):
+        return (args["n"] + 1) ** 2
+    if kind == "cylinder":
+        return (args["n_theta"] + 1) * (args["n_z"] + 1)
+    return None
 
 
 def _material(mat: Table, units: FileUnits):
@@ -227,6 +244,7 @@ def load_problem(path: str | Path) -> ProblemSpec:
     if nq not in (3, 6, 12):
         raise sh.error(f"must be 3, 6 or 12 points per face, got {nq}", "quadrature")
     interp = geo.boolean("interpolate", None)
+    check_memory(mesh.n_vertices, f"{p}: the mesh")
     shell = Shell(mesh.vertices, mesh.faces, material, thickness, n_quad=nq, interpolate=interp)
 
     regions = doc.table("regions", required=False)

@@ -9,6 +9,11 @@ Two remeshing methods:
   valence-5 vertices), the best control mesh for Loop subdivision; its vertices lie on the scan.
 * ``"decimate"`` — quadric edge-collapse decimation (Garland & Heckbert 1997, open3d's
   ``simplify_quadric_decimation``) to the chosen number of faces, for any closed scan.
+* ``"isotropic"`` — explicit isotropic remeshing (Botsch & Kobbelt 2004: split, collapse, flip,
+  tangential smoothing, reprojection; pymeshlab's ``meshing_isotropic_explicit_remeshing``) to the
+  edge length of about the chosen number of equilateral faces: near-equilateral triangles
+  (smallest angle 23-29 degrees on the mustard bottle and the duck, against 1 degree after
+  decimation) and valence 6 almost everywhere, what Loop subdivision converges best on.
 
 Both results are checked: ``validate_mesh`` (manifold, consistently oriented, no degenerate
 faces), closed, same Euler characteristic as the scan, outward orientation, and the two-sided
@@ -147,6 +152,20 @@ def _decimate(scan: TriMesh, n_faces: int) -> TriMesh:
     return TriMesh(np.asarray(out.vertices), np.asarray(out.triangles))
 
 
+def _isotropic(scan: TriMesh, n_faces: int) -> TriMesh:
+    try:
+        import pymeshlab  # lazy: only this method needs it
+    except ImportError as exc:
+        raise MeshError(f"method 'isotropic' needs pymeshlab ({exc}): pip install 'graspdef[objects]'") from exc
+    area = float(trimesh.Trimesh(scan.vertices, scan.faces, process=False).area)
+    length = math.sqrt(4.0 * area / (math.sqrt(3.0) * n_faces))     # n_faces equilateral triangles
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(scan.vertices, scan.faces))
+    ms.meshing_isotropic_explicit_remeshing(iterations=10, targetlen=pymeshlab.PureValue(length), featuredeg=180)
+    m = ms.current_mesh()
+    return TriMesh(np.asarray(m.vertex_matrix(), np.float64), np.asarray(m.face_matrix(), np.int64))
+
+
 def _relax(mesh: TriMesh, scan: TriMesh, iterations: int, step: float = 0.5) -> TriMesh:
     """Tangential umbrella smoothing, each step projected back onto the scan: evens out the
     triangles of a decimated mesh (connectivity unchanged)."""
@@ -179,9 +198,10 @@ def control_mesh(scan: TriMesh, n_faces: int, method: str = "auto", relax: int =
     n_faces : int
         Target number of faces (exact for ``"project"``, which needs ``20 * 4**k``; decimation
         reaches it to within a few faces).
-    method : {"auto", "project", "decimate"}
+    method : {"auto", "project", "decimate", "isotropic"}
         ``"auto"``: ``"project"`` when ``n_faces`` is an icosphere size and the scan is
-        star-shaped, otherwise ``"decimate"``.
+        star-shaped, otherwise ``"decimate"``.  ``"isotropic"`` reaches ``n_faces`` to within
+        about 10 %.
     relax : int
         Iterations of tangential smoothing projected onto the scan after decimation (0: none).
         Decimated meshes have slivers (smallest angle 1-2 degrees on the YCB mustard bottle and
@@ -204,8 +224,8 @@ def control_mesh(scan: TriMesh, n_faces: int, method: str = "auto", relax: int =
     ProblemError
         For an unknown method or an impossible size.
     """
-    if method not in ("auto", "project", "decimate"):
-        raise ProblemError(f"unknown remeshing method {method!r}; use auto, project or decimate")
+    if method not in ("auto", "project", "decimate", "isotropic"):
+        raise ProblemError(f"unknown remeshing method {method!r}; use auto, project, decimate or isotropic")
     if int(n_faces) < 20:
         raise ProblemError(f"n_faces must be >= 20, got {n_faces}")
     scan = clean_scan(scan)
@@ -223,6 +243,8 @@ def control_mesh(scan: TriMesh, n_faces: int, method: str = "auto", relax: int =
                 pass
     if method == "project":
         mesh = _project(scan, int(n_faces))
+    elif method == "isotropic":
+        mesh = _isotropic(scan, int(n_faces))
     else:
         mesh = _decimate(scan, int(n_faces))
         if relax:

@@ -137,7 +137,8 @@ def _fingertip(sc: Scene, side: str, body: int, axis: np.ndarray) -> dict:
     else:
         raise SimError(f"{sc.path}: no fingertip geom '{side}_pin' or '{side}_pad'")
     return {"geom": name, "type": mj.mjtGeom(int(m.geom_type[gid])).name.removeprefix("mjGEOM_").lower(),
-            "size": m.geom_size[gid].tolist(), "position": d.geom_xpos[gid].tolist(),
+            "size": m.geom_size[gid].tolist(), "friction": m.geom_friction[gid].tolist(),
+            "solref": m.geom_solref[gid].tolist(), "position": d.geom_xpos[gid].tolist(),
             "rotation": d.geom_xmat[gid].reshape(3, 3).tolist(), "axis": (axis / np.linalg.norm(axis)).tolist()}
 
 
@@ -176,19 +177,21 @@ def check_targets(sc: Scene, targets: dict) -> None:
                            f"({lo:g}..{hi:g} N, its actuator's range in the scene)")
 
 
-def grasp(scene, force: float | dict, object: str, settings: GraspSettings = GraspSettings()) -> GraspResult:
+def grasp(scene, force: float | dict, object: str, settings: GraspSettings = GraspSettings(),
+          fingertips=None) -> GraspResult:
     """Close the gripper of ``scene`` (a path or a :class:`Scene`) on body ``object`` until each
     finger presses with its target force [N], settle and extract the contacts.
 
     ``force``: one number (both fingers) or {"left": F_l, "right": F_r} (0 = finger stays open;
-    e.g. a one-finger poke).
+    e.g. a one-finger poke).  ``fingertips``: a per-run
+    :class:`graspdef.sim.gripper.FingertipChange` (pad size, material).
 
     Raises SimError: missing gripper/object, a target outside the actuators' range, no contact
     after closing, MuJoCo warnings, or a settled force off its target by more than
     ``settings.force_rtol_error``."""
     mj = mujoco()
     t_wall = time.perf_counter()
-    sc = scene if isinstance(scene, Scene) else load_scene(scene, object)
+    sc = scene if isinstance(scene, Scene) else load_scene(scene, object, fingertips)
     m, d = sc.model, sc.data
     targets = {s: float(force) for s in SIDES} if np.isscalar(force) else {s: float(force.get(s, 0.0)) for s in SIDES}
     check_targets(sc, targets)

@@ -82,8 +82,10 @@ class Scene:
         return float(np.linalg.norm(x["right"] - x["left"]))
 
 
-def load_scene(path, object: str) -> Scene:
+def load_scene(path, object: str, fingertips=None) -> Scene:
     """Compile ``path`` (an MJCF scene) and look up the gripper and the body ``object``.
+    ``fingertips``: a :class:`graspdef.sim.gripper.FingertipChange` (pad size, material) applied
+    to the scene's fingertip geoms for this run (None: the scene as written).
 
     Raises SimError if the file does not compile, or the parallel gripper (left/right finger
     bodies, joints, actuators) or the object body is missing."""
@@ -92,7 +94,12 @@ def load_scene(path, object: str) -> Scene:
     if not path.is_file():
         raise SimError(f"scene file not found: {path}")
     try:
-        model = mj.MjModel.from_xml_path(str(path))
+        if fingertips is None or fingertips.empty:
+            model = mj.MjModel.from_xml_path(str(path))
+        else:
+            spec = mj.MjSpec.from_file(str(path))
+            fingertips.apply(spec, path)
+            model = spec.compile()
     except ValueError as exc:
         raise SimError(f"{path}: MuJoCo cannot compile the scene: {str(exc).strip().splitlines()[0]}") from exc
     data = mj.MjData(model)

@@ -35,8 +35,8 @@ def test_tennis_ball_linear_chain(tmp_path):
 
 def test_bad_input_leaves_nothing(tmp_path, capsys):
     out = tmp_path / "bad"
-    assert grasp_cli(["tennis_ball", "--force", "45", "--analysis", "linear", "--out", str(out)]) == 2
-    assert "beyond what the gripper can exert (0..30 N" in capsys.readouterr().err
+    assert grasp_cli(["tennis_ball", "--force", "300", "--analysis", "linear", "--out", str(out)]) == 2
+    assert "beyond what the gripper can exert (0..235 N" in capsys.readouterr().err
     assert not out.exists()
     assert grasp_cli(["no_such_scene", "--force", "5", "--out", str(out)]) == 2
     assert grasp_cli(["tennis_ball", "--force", "nan", "--contact", "geometric", "--out", str(out)]) == 2

@@ -40,8 +40,9 @@ def test_sphere_squeezed_to_target(scene, force):
 
 
 def test_force_beyond_actuator_range():
-    with pytest.raises(SimError, match="beyond what the gripper"):
-        grasp(SCENES / "test_sphere" / "scene.xml", 45.0, "sphere")
+    """The shipped gripper covers real parallel grippers (0..235 N per finger); beyond: refused."""
+    with pytest.raises(SimError, match=r"300 N is beyond what the gripper can exert \(0\.\.235 N"):
+        grasp(SCENES / "test_sphere" / "scene.xml", 300.0, "sphere")
 
 
 def test_missing_object_and_gripper(tmp_path):

@@ -1,0 +1,160 @@
+"""Where the gripper takes an object: a grasp line (an axis through a point of the object, or the
+best antipodal pair of surface points found automatically) and the object's pose that puts that
+line on the gripper's closing axis with its chord's midpoint where the fingers meet.
+
+The parallel gripper (:mod:`graspdef.sim.gripper`) closes along the world x axis and its fingertips
+meet at the origin; gravity is -z.  The object frame is the mesh's own; the pose keeps the
+object's own z axis as close to upright as the grasp axis allows.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import trimesh
+
+from ..errors import ProblemError
+from ..geometry import TriMesh
+from ..scans import vertex_normals
+from ..sim.gripper import OPEN, TRAVEL
+
+#: clearance [m] kept between the object and the open fingertips, and beyond the closed ones
+CLEARANCE = 0.003
+
+
+@dataclass(frozen=True)
+class Grasp:
+    """A grasp line in the object frame [m]: the two contact points (entry, exit), the unit axis
+    from the first to the second, and the antipodal quality: the larger of the angles [deg]
+    between the chord and the inward surface normals at its ends (0: perfectly antipodal; the
+    grasp holds without slip while it is below atan(friction))."""
+
+    first: np.ndarray
+    second: np.ndarray
+    axis: np.ndarray
+    angle_deg: float
+    how: str
+
+    @property
+    def centre(self) -> np.ndarray:
+        return 0.5 * (self.first + self.second)
+
+    @property
+    def width(self) -> float:
+        return float(np.linalg.norm(self.second - self.first))
+
+    def record(self) -> dict:
+        return {"how": self.how, "first_contact_m": self.first.tolist(), "second_contact_m": self.second.tolist(),
+                "axis": self.axis.tolist(), "width_m": self.width, "antipodal_angle_deg": self.angle_deg}
+
+
+def _chord_angles(tm: trimesh.Trimesh, p, q, tri_p, tri_q) -> float:
+    d = (q - p) / np.linalg.norm(q - p)
+    n_p, n_q = tm.face_normals[tri_p], tm.face_normals[tri_q]
+    # at p the finger pushes along +d, against the outward normal n_p: antipodal when n_p = -d
+    a_p = math.degrees(math.acos(float(np.clip(-n_p @ d, -1, 1))))
+    a_q = math.degrees(math.acos(float(np.clip(n_q @ d, -1, 1))))
+    return max(a_p, a_q)
+
+
+def grasp_along(mesh: TriMesh, point, axis, where: str = "grasp") -> Grasp:
+    """The grasp on the line through ``point`` [m, object frame] along ``axis``: the contacts are
+    the line's first and last crossings of the surface."""
+    tm = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False)
+    a = np.asarray(axis, float)
+    if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) == 0:
+        raise ProblemError(f"{where}: the grasp axis must be a non-zero 3-vector, got {axis!r}")
+    a = a / np.linalg.norm(a)
+    p = np.asarray(point, float)
+    far = 2.0 * float(np.ptp(mesh.vertices, axis=0).max()) + float(np.linalg.norm(p - mesh.vertices.mean(axis=0)))
+    locs, _, tris = tm.ray.intersects_location([p - far * a], [a], multiple_hits=True)
+    if len(locs) < 2:
+        raise ProblemError(f"{where}: the line through ({', '.join(f'{1e3 * c:.4g}' for c in p)}) mm along "
+                           f"({', '.join(f'{c:.3g}' for c in a)}) misses the object (it crosses the surface "
+                           f"{len(locs)} times); give a point inside it")
+    t = (locs - (p - far * a)) @ a
+    i, j = int(np.argmin(t)), int(np.argmax(t))
+    return Grasp(locs[i], locs[j], a, _chord_angles(tm, locs[i], locs[j], tris[i], tris[j]), "given axis and point")
+
+
+def best_antipodal(mesh: TriMesh, centre_of_mass, friction: float, max_width: float, min_width: float) -> Grasp:
+    """The best antipodal pair of the surface: from every vertex a ray along the inward normal to
+    the surface's far side; a pair qualifies if its chord fits the gripper (``min_width`` to
+    ``max_width`` [m]), both ends lie inside the friction cone (angle < atan(friction)) and the
+    line crosses the surface only there (the fingers come from outside); among those the one of
+    least cost: the antipodal angle over the cone's, plus the line's distance from the centre of
+    mass (the weight's torque) over half the object's size."""
+    tm = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False)
+    n = vertex_normals(mesh)
+    size = float(np.ptp(mesh.vertices, axis=0).max())
+    locs, ray_idx, tris = tm.ray.intersects_location(mesh.vertices, -n, multiple_hits=True)
+    # the first crossing beyond the start (a ray from a vertex may report the start's own faces)
+    dist = np.einsum("ij,ij->i", locs - mesh.vertices[ray_idx], -n[ray_idx])
+    ok = dist > 1e-3 * size
+    locs, ray_idx, tris, dist = locs[ok], ray_idx[ok], tris[ok], dist[ok]
+    order = np.lexsort((dist, ray_idx))
+    first = order[np.r_[True, ray_idx[order][1:] != ray_idx[order][:-1]]] if len(order) else order
+    locs, ray_idx, tris = locs[first], ray_idx[first], tris[first]
+    cone = math.degrees(math.atan(friction))
+    com = np.asarray(centre_of_mass, float)
+    candidates = []
+    for q, i, tq in zip(locs, ray_idx, tris):
+        p = mesh.vertices[i]
+        w = float(np.linalg.norm(q - p))
+        if not (min_width <= w <= max_width):
+            continue
+        d = (q - p) / w
+        a_p = math.degrees(math.acos(float(np.clip(n[i] @ -d, -1, 1))))
+        a_q = math.degrees(math.acos(float(np.clip(tm.face_normals[tq] @ d, -1, 1))))
+        angle = max(a_p, a_q)
+        if angle >= cone:
+            continue
+        off = float(np.linalg.norm(np.cross(com - p, d)))      # distance of the line from the COM
+        # cost: the antipodal angle as a fraction of the friction cone, plus the line's distance from the
+        # centre of mass as a fraction of half the object's size (both 0 at the ideal grasp)
+        cost = angle / cone + off / (0.5 * size)
+        candidates.append(((round(cost, 6), int(i)), p.copy(), q.copy(), d, angle))
+    candidates.sort(key=lambda c: c[0])
+    best = None
+    for _key, p, q, d, angle in candidates[:200]:
+        # the fingers come from outside along the line: p and q must be its first and last crossings
+        far = 2.0 * size
+        hits, _, _ = tm.ray.intersects_location([p - far * d], [d], multiple_hits=True)
+        t = (hits - (p - far * d)) @ d
+        if len(t) and t.min() >= far - 1e-4 * size and t.max() <= far + np.linalg.norm(q - p) + 1e-4 * size:
+            best = Grasp(p, q, d, angle, "best antipodal pair (automatic)")
+            break
+    if best is None:
+        raise ProblemError(f"no antipodal grasp found: no pair of surface points {min_width * 1e3:.0f} to "
+                           f"{max_width * 1e3:.0f} mm apart (the gripper's opening) with both normals within the "
+                           f"friction cone ({cone:.0f} deg for friction {friction:g}); give --grasp-axis and "
+                           "--grasp-point")
+    return best
+
+
+def pose_for(mesh: TriMesh, grasp: Grasp, where: str = "grasp") -> tuple[np.ndarray, np.ndarray]:
+    """(position [m], rotation matrix object -> world) that puts ``grasp``'s axis on the world x
+    axis and its chord's midpoint at the origin, the object's z axis as upright as possible.
+    Refuses a grasp the gripper cannot make: a chord outside its opening, or an object that the
+    open fingers would cut."""
+    x = grasp.axis
+    up = np.array([0.0, 0.0, 1.0])
+    if abs(x @ up) > 0.99:
+        up = np.array([0.0, 1.0, 0.0])
+    z = up - (up @ x) * x
+    z /= np.linalg.norm(z)
+    y = np.cross(z, x)
+    R = np.vstack([x, y, z])                      # rows: world axes in the object frame
+    pos = -R @ grasp.centre
+    lo, hi = 2 * (OPEN - TRAVEL) + 2 * CLEARANCE, 2 * (OPEN - CLEARANCE)
+    if not lo <= grasp.width <= hi:
+        raise ProblemError(f"{where}: the grasp is {grasp.width * 1e3:.1f} mm wide; the gripper takes "
+                           f"{lo * 1e3:.0f} to {hi * 1e3:.0f} mm: choose another grasp (--grasp-axis, --grasp-point)")
+    xw = (mesh.vertices @ R.T + pos)[:, 0]
+    reach = float(np.abs(xw).max())
+    if reach > OPEN - CLEARANCE:
+        raise ProblemError(f"{where}: placed for this grasp the object reaches {reach * 1e3:.1f} mm from the grasp "
+                           f"centre along the closing axis, beyond the open fingertips at {OPEN * 1e3:.0f} mm: "
+                           "choose a grasp across a narrower part")
+    return pos, R
