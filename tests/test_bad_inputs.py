@@ -16,6 +16,9 @@ REPO = Path(__file__).resolve().parents[1]
 
 PLATE = plate_problem("plate", 4, probe=False)
 
+#: a plate of 20,000 x 20,000 cells: 400 million control vertices, refused before it is generated
+BIG_SPHERE = PLATE.replace("nx = 4\nny = 4", "nx = 20000\nny = 20000")
+
 TRI = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
 
 SPEC = """
@@ -52,6 +55,35 @@ def _file(tmp: Path, name: str, text: str | bytes) -> str:
     p = tmp / name
     p.write_bytes(text) if isinstance(text, bytes) else p.write_text(text)
     return str(p)
+
+
+def _mesh(tmp: Path, name: str, kind: str = "sphere") -> str:
+    """A mesh file [mm] for ``object add``: a closed sphere (R 30 mm, or 100 mm: "big"), an open
+    one, two spheres, a point cloud, or a tetrahedron with a fin on one edge (non-manifold)."""
+    import numpy as np
+    import trimesh
+
+    s = trimesh.creation.icosphere(3, 30.0)
+    if kind == "big":
+        s = trimesh.creation.icosphere(3, 100.0)
+    elif kind == "open":
+        s.update_faces(s.face_normals[:, 2] < 0.5)          # the top cap cut off
+        s.remove_unreferenced_vertices()
+    elif kind == "two":
+        s = trimesh.util.concatenate([s, s.copy().apply_translation([100.0, 0, 0])])
+    elif kind == "cloud":
+        p = tmp / name
+        p.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                     "property float z\nend_header\n0 0 0\n10 0 0\n0 10 0\n")
+        return str(p)
+    elif kind == "fin":
+        v = np.array([[0, 0, 0], [40, 0, 0], [0, 40, 0], [0, 0, 40], [20, -30, 20.0]])
+        s = trimesh.Trimesh(v, [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2], [0, 1, 4]], process=False)
+    s.export(tmp / name)
+    return str(tmp / name)
+
+
+ADD = ["--thickness", "1mm", "--law", "neo-hookean", "--E", "2MPa", "--nu", "0.45", "--mass", "50g"]
 
 
 def _case(name: str, tmp: Path) -> tuple[list[str], str]:
@@ -98,6 +130,41 @@ def _case(name: str, tmp: Path) -> tuple[list[str], str]:
         "grasp: thickness outside the thin-shell range": lambda: (
             ["grasp", _scene_copy(tmp, _replace('thickness = "2.5 mm"', 'thickness = "0.004 mm"')), "--force", "5",
              "--analysis", "linear", "--out", out], "a thin shell needs"),
+        "grasp: pad size with pin fingertips": lambda: (["grasp", "tennis_ball", "--pad-size", "30mm", "--force", "5",
+                                                    "--out", out], "a pad size is for pad fingertips"),
+        # --- object add (a mesh of one's own)
+        "object add: missing mesh": lambda: (["object", "add", "ball", "--mesh", str(tmp / "no.stl"), *ADD, "--out", out],
+                                     "file not found"),
+        "object add: unknown mesh format": lambda: (["object", "add", "ball", "--mesh", _file(tmp, "b.xyz", "0 0 0\n"),
+                                             *ADD, "--out", out], "unknown mesh format '.xyz'"),
+        "object add: point cloud": lambda: (["object", "add", "ball", "--mesh", _mesh(tmp, "c.ply", "cloud"), "--units",
+                                     "mm", *ADD, "--out", out], "a point cloud"),
+        "object add: open surface": lambda: (["object", "add", "ball", "--mesh", _mesh(tmp, "o.stl", "open"), *ADD,
+                                      "--out", out], "the surface is open: 1 hole ("),
+        "object add: two objects in one file": lambda: (["object", "add", "ball", "--mesh", _mesh(tmp, "t.stl", "two"),
+                                                 *ADD, "--out", out], "2 separate objects in one file"),
+        "object add: non-manifold edge": lambda: (["object", "add", "ball", "--mesh", _mesh(tmp, "f.obj", "fin"),
+                                           "--units", "mm", *ADD, "--out", out], "1 non-manifold edge (shared by 3 or more faces), e.g. vertex pairs (0, 1) at (20.00, 0.00, 0.00) mm"),
+        "object add: bad name": lambda: (["object", "add", "my ball", "--mesh", _mesh(tmp, "s.stl"), *ADD, "--out", out],
+                                 "object name 'my ball'"),
+        "object add: no mass or density": lambda: (["object", "add", "ball", "--mesh", _mesh(tmp, "s.stl"), *ADD[:-2],
+                                            "--out", out], "--density"),
+        "object add: thickness outside the thin-shell range": lambda: (
+            ["object", "add", "ball", "--mesh", _mesh(tmp, "s.stl"), *ADD[:1], "0.001mm", *ADD[2:], "--out", out],
+            "a thin shell needs"),
+        "object add: E in the wrong unit": lambda: (["object", "add", "ball", "--mesh", _mesh(tmp, "s.stl"), *ADD[:5],
+                                             "2mm", *ADD[6:], "--out", out], "expected a pressure"),
+        "object add: grasp axis without a point": lambda: (["object", "add", "ball", "--mesh", _mesh(tmp, "s.stl"), *ADD,
+                                                    "--grasp-axis", "[1, 0, 0]", "--out", out], "together"),
+        "object add: grasp wider than the gripper": lambda: (
+            ["object", "add", "ball", "--mesh", _mesh(tmp, "b.stl", "big"), *ADD, "--grasp-axis", "[1, 0, 0]",
+             "--grasp-point", "[0, 0, 0] mm", "--out", out], "the gripper takes"),
+        "object add: too many faces": lambda: (["object", "add", "ball", "--mesh", _mesh(tmp, "s.stl"), *ADD, "--faces",
+                                        "1000000", "--out", out], "--faces must be"),
+        "object add: --out not empty": lambda: (["object", "add", "ball", "--mesh", _mesh(tmp, "s.stl"), *ADD, "--out",
+                                         str(tmp / "photos")], "not empty"),
+        "solve: mesh too large for the memory": lambda: (
+            ["solve", _file(tmp, "big.toml", BIG_SPHERE), "--out", out], "GiB to solve"),
         # --- report / view / score on run folders
         "report: missing folder": lambda: (["report", str(tmp / "nowhere")], "does not exist"),
         "report: not a run folder": lambda: (["report", str(tmp / "photos")], "incomplete"),
@@ -134,7 +201,13 @@ NAMES = sorted([
     "object: wrong dimension", "object: unknown scene", "grasp: thickness outside the thin-shell range", "report: missing folder", "report: not a run folder",
     "report: bad table file", "view: missing folder", "score: missing prediction", "score: unknown scan id",
     "score: empty scan", "sweep: unknown key", "sweep: force beyond the gripper", "sweep: unreachable scheduler",
-    "bench: missing folder"])
+    "bench: missing folder", "grasp: pad size with pin fingertips", "object add: missing mesh",
+    "object add: unknown mesh format", "object add: point cloud", "object add: open surface",
+    "object add: two objects in one file", "object add: non-manifold edge", "object add: bad name",
+    "object add: no mass or density", "object add: thickness outside the thin-shell range",
+    "object add: E in the wrong unit", "object add: grasp axis without a point",
+    "object add: grasp wider than the gripper", "object add: too many faces", "object add: --out not empty",
+    "solve: mesh too large for the memory"])
 
 
 def test_the_matrix_has_at_least_30_classes():

@@ -38,7 +38,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add.add_argument("--material-source", default="", help="where E and nu come from (stored in object.toml)")
     add.add_argument("--gas", help="enclosed air's gauge pressure of the unloaded object, e.g. 80kPa (default: none)")
     add.add_argument("--gas-source", default="", help="where the pressure comes from (stored in object.toml)")
-    mass = add.add_mutually_exclusive_group(required=True)
+    mass = add.add_mutually_exclusive_group()
     mass.add_argument("--density", help="the wall's density, e.g. 950kg/m^3 (mass = density x thickness x area)")
     mass.add_argument("--mass", help="the whole object's mass, e.g. 60g (spread over its surface)")
     add.add_argument("--friction", type=float, default=0.8, help="Coulomb friction of the object's surface (0.8)")

@@ -33,6 +33,11 @@ class RepairedSurface:
     repairs: list[str] = field(default_factory=list)
 
 
+def _n(count: int, word: str) -> str:
+    """``3 holes``, ``1 hole``."""
+    return f"{count} {word}" if count == 1 else f"{count} {word}s"
+
+
 def _mm(p) -> str:
     return "(" + ", ".join(f"{1e3 * c:.2f}" for c in np.asarray(p, float)) + ") mm"
 
@@ -101,6 +106,24 @@ def _split_sheets(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     return v, f, len(extra)
 
 
+def _components(tm: trimesh.Trimesh) -> list[trimesh.Trimesh]:
+    """The edge-connected pieces of a surface (scipy; no networkx)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    adj = np.asarray(tm.face_adjacency)
+    n = len(tm.faces)
+    g = coo_matrix((np.ones(len(adj)), (adj[:, 0], adj[:, 1])), shape=(n, n)) if len(adj) else coo_matrix((n, n))
+    k, label = connected_components(g, directed=False)
+    if k == 1:
+        return [tm]
+    out = []
+    for c in range(k):
+        sub = tm.submesh([np.flatnonzero(label == c)], append=True, repair=False)
+        out.append(sub)
+    return out
+
+
 def repair_surface(vertices: np.ndarray, faces: np.ndarray, where: str) -> RepairedSurface:
     """Make ``(vertices [m], faces)`` a closed, outward-oriented manifold surface of one object,
     or raise MeshError naming the offending elements (``where``: the file, for messages)."""
@@ -115,7 +138,7 @@ def repair_surface(vertices: np.ndarray, faces: np.ndarray, where: str) -> Repai
     tm.update_faces(tm.unique_faces())
     tm.remove_unreferenced_vertices()
     if len(tm.faces) < n0:
-        repairs.append(f"removed {n0 - len(tm.faces)} duplicate faces")
+        repairs.append(f"removed {_n(n0 - len(tm.faces), 'duplicate face')}")
     if not is_closed(tm.faces):
         # triangle soup (STL) or split seams: weld coincident vertices, if that closes the surface
         welded = tm.copy()
@@ -123,25 +146,28 @@ def repair_surface(vertices: np.ndarray, faces: np.ndarray, where: str) -> Repai
         nf = len(welded.faces)
         welded.update_faces(welded.nondegenerate_faces())
         welded.remove_unreferenced_vertices()
-        if is_closed(welded.faces) or len(boundary_loops(welded.faces)) < len(boundary_loops(tm.faces)):
+        def open_edges(faces):
+            return int(np.sum(edge_face_counts(np.asarray(faces))[1] == 1))
+
+        if open_edges(welded.faces) < open_edges(tm.faces):
             repairs.append(f"welded coincident vertices ({len(tm.vertices)} -> {len(welded.vertices)})"
-                           + (f", dropped {nf - len(welded.faces)} collapsed faces" if nf > len(welded.faces) else ""))
+                           + (f", dropped {_n(nf - len(welded.faces), 'collapsed face')}" if nf > len(welded.faces) else ""))
             tm = welded
     edges, counts = edge_face_counts(np.asarray(tm.faces))
     if np.any(counts > 2) and np.all(counts[counts > 2] % 2 == 0):
         v2, f2, copies = _split_sheets(np.asarray(tm.vertices, float), np.asarray(tm.faces))
         e2, c2 = edge_face_counts(f2)
         if not np.any(c2 > 2):
-            repairs.append(f"split {int(np.sum(counts > 2))} edges where two sheets of the surface touch "
-                           f"({copies} vertex copies)")
+            repairs.append(f"split {_n(int(np.sum(counts > 2)), 'edge')} where two sheets of the surface "
+                           f"touch ({copies} vertex {'copy' if copies == 1 else 'copies'})")
             tm = trimesh.Trimesh(v2, f2, process=False)
             edges, counts = e2, c2
     bad = np.flatnonzero(counts > 2)
     if bad.size:
         e = edges[bad]
-        raise MeshError(f"{where}: {bad.size} non-manifold edges (shared by 3 or more faces), e.g. vertex pairs "
+        raise MeshError(f"{where}: {_n(bad.size, 'non-manifold edge')} (shared by 3 or more faces), e.g. vertex pairs "
                         f"{_listing(e, tm.vertices[e].mean(axis=1))}: separate the touching parts in a mesh editor")
-    parts = tm.split(only_watertight=False)
+    parts = _components(tm)
     if len(parts) > 1:
         areas = np.array([p.area for p in parts])
         keep = areas >= DEBRIS_AREA * areas.max()
@@ -150,22 +176,26 @@ def repair_surface(vertices: np.ndarray, faces: np.ndarray, where: str) -> Repai
             raise MeshError(f"{where}: {int(keep.sum())} separate objects in one file (areas "
                             + ", ".join(f"{areas[i] * 1e6:.0f} mm^2 around {_mm(parts[i].centroid)}" for i in big)
                             + "): give one object per file")
-        repairs.append(f"dropped {int((~keep).sum())} loose pieces of debris ({areas[~keep].sum() * 1e6:.2g} mm^2, "
+        repairs.append(f"dropped {int((~keep).sum())} loose {'piece' if (~keep).sum() == 1 else 'pieces'} of debris ({areas[~keep].sum() * 1e6:.2g} mm^2, "
                        f"< {DEBRIS_AREA:.0%} of the object)")
         tm = parts[int(np.argmax(areas))]
     if not is_closed(tm.faces):
         loops = boundary_loops(np.asarray(tm.faces))
         small = [lp for lp in loops if len(lp) <= SMALL_HOLE_EDGES]
         if len(small) == len(loops):
-            before = len(tm.faces)
-            trimesh.repair.fill_holes(tm)
-            if is_closed(tm.faces):
-                repairs.append(f"closed {len(loops)} small holes ({len(tm.faces) - before} faces added)")
+            # a fan from each loop's first vertex, oriented like the loop's faces (the boundary edges
+            # run with their face on the left, so the patch runs against them)
+            patch = [[lp[0], lp[k + 1], lp[k]] for lp in loops for k in range(1, len(lp) - 1)]
+            closed = trimesh.Trimesh(tm.vertices, np.vstack([tm.faces, np.array(patch, dtype=np.int64)
+                                                              .reshape(-1, 3)]), process=False)
+            if is_closed(closed.faces):
+                repairs.append(f"closed {_n(len(loops), 'small hole')} ({_n(len(patch), 'face')} added)")
+                tm = closed
         if not is_closed(tm.faces):
             loops = boundary_loops(np.asarray(tm.faces))
             loops.sort(key=len, reverse=True)
             desc = "; ".join(f"{len(lp)} edges around {_mm(tm.vertices[lp].mean(axis=0))}" for lp in loops[:3])
-            raise MeshError(f"{where}: the surface is open: {len(loops)} holes ({desc}"
+            raise MeshError(f"{where}: the surface is open: {_n(len(loops), 'hole')} ({desc}"
                             + (" ..." if len(loops) > 3 else "") + "); a closed object needs a watertight "
                             "surface (close the holes, e.g. by Poisson reconstruction)")
     if not tm.is_winding_consistent:
