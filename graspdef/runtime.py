@@ -14,7 +14,11 @@ it first thing, before any solve (it only helps speed, never changes a result):
   :func:`locate_mkl_rt` names it once when it sits in the environment's ``lib`` folder (pip's
   mkl wheel).
 
-Both only fill in environment variables the user has not set.
+* **numba's threading layer.**  numba tries TBB first; the TBB that pymeshlab and open3d bring
+  is too old for it (a warning), so numba runs on OpenMP anyway.  ``NUMBA_THREADING_LAYER=omp``
+  states that choice (the same layer in every process, whatever was imported first, and no warning).
+
+All only fill in environment variables the user has not set.
 """
 from __future__ import annotations
 
@@ -34,6 +38,9 @@ def locate_mkl_rt() -> str | None:
 
 
 def configure() -> dict:
-    """Set the OpenMP wait policy (unless set) and locate MKL's runtime; returns what is in effect."""
+    """Set the OpenMP wait policy and numba's threading layer (unless set) and locate MKL's runtime;
+    returns what is in effect."""
     os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
-    return {"OMP_WAIT_POLICY": os.environ["OMP_WAIT_POLICY"], "PYPARDISO_MKL_RT": locate_mkl_rt()}
+    os.environ.setdefault("NUMBA_THREADING_LAYER", "omp")
+    return {"OMP_WAIT_POLICY": os.environ["OMP_WAIT_POLICY"], "NUMBA_THREADING_LAYER": os.environ["NUMBA_THREADING_LAYER"],
+            "PYPARDISO_MKL_RT": locate_mkl_rt()}

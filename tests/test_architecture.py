@@ -151,6 +151,6 @@ def test_import_changes_nothing():
             "assert dict(os.environ) == before, set(os.environ.items()) ^ set(before.items()); "
             "heavy = sorted(m for m in ('numpy', 'scipy', 'numba', 'trimesh', 'mujoco', 'open3d', 'viser') "
             "if m in sys.modules); assert not heavy, heavy")
-    env = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "PYPARDISO_MKL_RT")}
+    env = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "PYPARDISO_MKL_RT", "NUMBA_THREADING_LAYER")}
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
     assert r.returncode == 0, r.stderr

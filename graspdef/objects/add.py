@@ -66,7 +66,7 @@ class AddedObject:
         cm, g = r["control_mesh"], r["grasp"]
         hist = ", ".join(f"{k}: {v}" for k, v in cm["valence_histogram"].items())
         return [
-            f"{r['name']}: {r['input']['file']} ({r['input']['units']}: {r['input']['units_reason']}), "
+            f"{r['name']}: {Path(r['input']['file']).name} ({r['input']['units']}: {r['input']['units_reason']}), "
             f"{r['input']['size_mm'][0]:.1f} x {r['input']['size_mm'][1]:.1f} x {r['input']['size_mm'][2]:.1f} mm",
             *(f"  repaired: {x}" for x in r["repairs"]),
             f"  control mesh: {cm['n_vertices']} vertices, {cm['n_faces']} faces (isotropic remeshing); smallest "
