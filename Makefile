@@ -8,8 +8,10 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: setup demo test test-slow clean system-packages
 
-# Debian packages the Python dependencies need at run time (installed when run as root).
-DEB_PACKAGES := libgomp1 libusb-1.0-0 chromium chromium-driver
+# Debian packages the Python dependencies need at run time (installed when run as root):
+# libgomp1 (numba's OpenMP), libusb-1.0-0 (open3d), chromium + driver (browser tests), and
+# pymeshlab's shared libraries: libgl1, libopengl0, libfontconfig1, libgmp10 (it loads them at import)
+DEB_PACKAGES := libgomp1 libusb-1.0-0 chromium chromium-driver libgl1 libopengl0 libfontconfig1 libgmp10
 
 system-packages:
 	@if [ "$$(id -u)" = "0" ] && command -v apt-get >/dev/null 2>&1; then \

@@ -19,6 +19,29 @@ PLATE = plate_problem("plate", 4, probe=False)
 #: a plate of 20,000 x 20,000 cells: 400 million control vertices, refused before it is generated
 BIG_SPHERE = PLATE.replace("nx = 4\nny = 4", "nx = 20000\nny = 20000")
 
+#: a free sphere (held by rigid_modes only) pushed by one force: nothing balances it
+UNBALANCED = """
+name = "unbalanced"
+[units]
+length = "mm"
+force = "N"
+[geometry]
+type = "sphere"
+radius = 30.0
+subdivisions = 2
+[material]
+E = 1.0
+nu = 0.3
+[shell]
+thickness = 1.0
+[[supports]]
+kind = "rigid_modes"
+[[loads]]
+kind = "point"
+at = [30.0, 0.0, 0.0]
+force = [-1.0, 0.0, 0.0]
+"""
+
 TRI = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
 
 SPEC = """
@@ -163,6 +186,8 @@ def _case(name: str, tmp: Path) -> tuple[list[str], str]:
                                         "1000000", "--out", out], "--faces must be"),
         "object add: --out not empty": lambda: (["object", "add", "ball", "--mesh", _mesh(tmp, "s.stl"), *ADD, "--out",
                                          str(tmp / "photos")], "not empty"),
+        "solve: unbalanced loads on a free body": lambda: (
+            ["solve", _file(tmp, "ub.toml", UNBALANCED), "--out", out], "net force (-1, 0, 0) N"),
         "solve: mesh too large for the memory": lambda: (
             ["solve", _file(tmp, "big.toml", BIG_SPHERE), "--out", out], "GiB to solve"),
         # --- report / view / score on run folders
@@ -207,7 +232,7 @@ NAMES = sorted([
     "object add: no mass or density", "object add: thickness outside the thin-shell range",
     "object add: E in the wrong unit", "object add: grasp axis without a point",
     "object add: grasp wider than the gripper", "object add: too many faces", "object add: --out not empty",
-    "solve: mesh too large for the memory"])
+    "solve: mesh too large for the memory", "solve: unbalanced loads on a free body"])
 
 
 def test_the_matrix_has_at_least_30_classes():

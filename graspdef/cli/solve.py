@@ -34,6 +34,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     progress(args, f"reading {args.problem}")
     spec = load_problem(args.problem)
+    spec.problem.check_self_equilibrated(where=str(args.problem))
     shell = spec.problem.shell
     progress(args, f"shell: {shell.mesh.n_real} control vertices (+{shell.n_control - shell.mesh.n_real} ghosts), "
                    f"{shell.mesh.n_real_faces} faces; set-up {time.perf_counter() - t0:.2f} s")

@@ -12,6 +12,10 @@ from ..subdivision.evaluate import SurfaceEvaluator, project_point
 from .loads import PointLoad, load_vector
 from .potentials import EnclosedGas, is_potential
 from .nitsche import NitscheRotation
+
+#: net dead load, relative to the loads' magnitude, above which a body held only by rigid_modes is
+#: refused (loads given to 4 digits balance to ~1e-5; MuJoCo's settled grasps to ~1e-6)
+SELF_EQUILIBRIUM_RTOL = 1e-3
 from .terms import DeadLoads, NitscheTerm, RestQuadratic, ShellElastic
 from .supports import RigidModes, check_rigid_modes, constraint_rows, independent_rows, three_point_supports
 
@@ -91,6 +95,34 @@ class Problem:
     def dead_load_vector(self) -> np.ndarray:
         """Sum of the dead (configuration-independent) loads, (3 n_control,) [N]."""
         return load_vector(self.shell, [ld for ld in self.loads if not is_potential(ld)], self.evaluator)
+
+    def net_load(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """(net force [N], net moment about the origin [N m], sum of the control-point force
+        magnitudes [N]) of the dead loads at rest.  Exact for the limit surface: the Loop basis
+        reproduces affine fields, so sum_i x_i x f_i is the moment of the loads where they act."""
+        f = self.dead_load_vector().reshape(-1, 3)
+        return f.sum(axis=0), np.cross(self.shell.rest_positions, f).sum(axis=0), float(np.linalg.norm(f, axis=1).sum())
+
+    def check_self_equilibrated(self, rtol: float = SELF_EQUILIBRIUM_RTOL, where: str = "problem") -> None:
+        """Refuse dead loads that are not in equilibrium when only ``rigid_modes`` hold the body
+        (nothing would carry the net force: the solution would be the rigid-mode projection's
+        artefact).  Tolerance: ``rtol`` of the loads' magnitude (moment: times the body's size)."""
+        from .supports import RigidModes
+
+        if not self.supports or not all(isinstance(s, RigidModes) for s in self.supports):
+            return
+        F, M, scale = self.net_load()
+        if scale == 0.0:
+            return
+        size = float(np.ptp(self.shell.rest_positions, axis=0).max())
+        c = self.shell.rest_positions.mean(axis=0)
+        Mc = M - np.cross(c, F)                              # about the centroid
+        if np.linalg.norm(F) > rtol * scale or np.linalg.norm(Mc) > rtol * scale * size:
+            raise ProblemError(
+                f"{where}: the loads are not in equilibrium, and only rigid_modes hold the body: net force "
+                f"({', '.join(f'{v:.4g}' for v in F)}) N, net moment about the centroid "
+                f"({', '.join(f'{v:.4g}' for v in Mc)}) N m (tolerance {rtol:g} of the loads, {rtol * scale:.3g} N); "
+                "balance the loads or add supports")
 
     def potentials(self) -> list:
         """The configuration-dependent loads as ready energy terms on this shell (fresh state)."""

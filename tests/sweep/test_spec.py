@@ -68,7 +68,7 @@ def test_default_axes():
     (("materials = [\"linear\", \"soft\"]", "materials = [\"linear\", \"sofft\"]"),
      "unknown material 'sofft' (did you mean 'soft'?)"),
     (("contacts = [\"point\"]", "contacts = [\"pointt\"]"), "unknown contact model 'pointt' (did you mean 'point'?)"),
-    (("forces_N = [5.0, 10.0]", "forces_N = [5.0, 45.0]"), "45 N is beyond what the actuators"),
+    (("forces_N = [5.0, 10.0]", "forces_N = [5.0, 450.0]"), "450 N is beyond what the actuators"),
     (("forces_N = [5.0, 10.0]", "forces_N = [5.0, 5.0]"), "[grid] forces_N repeats 5"),
     (("forces_N = [5.0, 10.0]", "forces_N = [-5.0]"), "forces_N must be positive"),
     (("analysis = \"nonlinear\"", "analysis = \"nonlinar\""),
