@@ -11,6 +11,7 @@ arguments into typed inputs and calls a library function.
     graspdef sweep SPEC.toml --out DIR [--workers N | --scheduler tcp://HOST:PORT]   a grid of grasps
     graspdef object show SCENE                 what a grasp of this object will use (law, E, nu, gas)
     graspdef object add NAME --mesh FILE ...   a mesh of your own -> an object folder to grasp
+    graspdef rank OBJECT --force F --out DIR   where to grasp: antipodal candidates ranked (linear screen)
 
 Every error a user can cause prints one line ``graspdef: error: ...`` and exits with status 2.
 Building the parser imports no numerical package (``graspdef --help`` stays fast).
@@ -22,11 +23,11 @@ import logging
 import sys
 
 from ..errors import GraspdefError
-from . import bench, grasp, obj, report, score, solve, sweep, view
+from . import bench, grasp, obj, rank, report, score, solve, sweep, view
 
 #: subcommands in the order of ``graspdef --help``
 COMMANDS = {"solve": solve, "bench": bench, "score": score, "grasp": grasp, "view": view, "report": report,
-            "sweep": sweep, "object": obj}
+            "sweep": sweep, "object": obj, "rank": rank}
 
 EPILOG = """examples:
   graspdef solve benchmarks/plate_ss_uniform.toml --out out/plate

@@ -78,19 +78,24 @@ def grasp_along(mesh: TriMesh, point, axis, where: str = "grasp") -> Grasp:
     return Grasp(locs[i], locs[j], a, _chord_angles(tm, locs[i], locs[j], tris[i], tris[j]), "given axis and point")
 
 
-def best_antipodal(mesh: TriMesh, centre_of_mass, friction: float, max_width: float, min_width: float) -> Grasp:
-    """The best antipodal pair of the surface: from every vertex a ray along the inward normal to
-    the surface's far side; a pair qualifies if its chord fits the gripper (``min_width`` to
-    ``max_width`` [m]), both ends lie inside the friction cone (angle < atan(friction)) and the
-    line crosses the surface only there (the fingers come from outside); among those the one of
-    least cost: the antipodal angle over the cone's, plus the line's distance from the centre of
-    mass (the weight's torque) over half the object's size."""
+def antipodal_candidates(mesh: TriMesh, centre_of_mass, friction: float, max_width: float, min_width: float,
+                         n: int | None = None, seed: int = 0, limit: int | None = None) -> list[Grasp]:
+    """Antipodal grasps of the surface, least cost first: from each start point (every vertex,
+    and with ``n`` above the vertex count, ``n`` - vertices seeded random surface points) a ray
+    along the inward normal to the surface's far side; a pair qualifies if its chord fits the
+    gripper (``min_width`` to ``max_width`` [m]), both ends lie inside the friction cone (angle <
+    atan(friction)) and the line crosses the surface only there (the fingers come from outside).
+    Cost: the antipodal angle over the cone's, plus the line's distance from the centre of mass
+    (the weight's torque) over half the object's size.  ``limit``: stop after that many."""
     tm = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False)
-    n = vertex_normals(mesh)
+    starts, normals = mesh.vertices, vertex_normals(mesh)
+    if n is not None and n > len(starts):
+        pts, fi = trimesh.sample.sample_surface(tm, int(n) - len(starts), seed=seed)
+        starts, normals = np.vstack([starts, pts]), np.vstack([normals, tm.face_normals[fi]])
     size = float(np.ptp(mesh.vertices, axis=0).max())
-    locs, ray_idx, tris = tm.ray.intersects_location(mesh.vertices, -n, multiple_hits=True)
+    locs, ray_idx, tris = tm.ray.intersects_location(starts, -normals, multiple_hits=True)
     # the first crossing beyond the start (a ray from a vertex may report the start's own faces)
-    dist = np.einsum("ij,ij->i", locs - mesh.vertices[ray_idx], -n[ray_idx])
+    dist = np.einsum("ij,ij->i", locs - starts[ray_idx], -normals[ray_idx])
     ok = dist > 1e-3 * size
     locs, ray_idx, tris, dist = locs[ok], ray_idx[ok], tris[ok], dist[ok]
     order = np.lexsort((dist, ray_idx))
@@ -100,37 +105,43 @@ def best_antipodal(mesh: TriMesh, centre_of_mass, friction: float, max_width: fl
     com = np.asarray(centre_of_mass, float)
     candidates = []
     for q, i, tq in zip(locs, ray_idx, tris):
-        p = mesh.vertices[i]
+        p = starts[i]
         w = float(np.linalg.norm(q - p))
         if not (min_width <= w <= max_width):
             continue
         d = (q - p) / w
-        a_p = math.degrees(math.acos(float(np.clip(n[i] @ -d, -1, 1))))
+        a_p = math.degrees(math.acos(float(np.clip(normals[i] @ -d, -1, 1))))
         a_q = math.degrees(math.acos(float(np.clip(tm.face_normals[tq] @ d, -1, 1))))
         angle = max(a_p, a_q)
         if angle >= cone:
             continue
         off = float(np.linalg.norm(np.cross(com - p, d)))      # distance of the line from the COM
-        # cost: the antipodal angle as a fraction of the friction cone, plus the line's distance from the
-        # centre of mass as a fraction of half the object's size (both 0 at the ideal grasp)
         cost = angle / cone + off / (0.5 * size)
         candidates.append(((round(cost, 6), int(i)), p.copy(), q.copy(), d, angle))
     candidates.sort(key=lambda c: c[0])
-    best = None
-    for _key, p, q, d, angle in candidates[:200]:
+    out = []
+    far = 2.0 * size
+    for _key, p, q, d, angle in candidates:
         # the fingers come from outside along the line: p and q must be its first and last crossings
-        far = 2.0 * size
         hits, _, _ = tm.ray.intersects_location([p - far * d], [d], multiple_hits=True)
         t = (hits - (p - far * d)) @ d
         if len(t) and t.min() >= far - 1e-4 * size and t.max() <= far + np.linalg.norm(q - p) + 1e-4 * size:
-            best = Grasp(p, q, d, angle, "best antipodal pair (automatic)")
-            break
-    if best is None:
+            out.append(Grasp(p, q, d, angle, "best antipodal pair (automatic)"))
+            if limit is not None and len(out) >= limit:
+                break
+    return out
+
+
+def best_antipodal(mesh: TriMesh, centre_of_mass, friction: float, max_width: float, min_width: float) -> Grasp:
+    """The least-cost antipodal grasp of :func:`antipodal_candidates` (its vertices only)."""
+    found = antipodal_candidates(mesh, centre_of_mass, friction, max_width, min_width, limit=1)
+    if not found:
+        cone = math.degrees(math.atan(friction))
         raise ProblemError(f"no antipodal grasp found: no pair of surface points {min_width * 1e3:.0f} to "
                            f"{max_width * 1e3:.0f} mm apart (the gripper's opening) with both normals within the "
                            f"friction cone ({cone:.0f} deg for friction {friction:g}); give --grasp-axis and "
                            "--grasp-point")
-    return best
+    return found[0]
 
 
 def pose_for(mesh: TriMesh, grasp: Grasp, where: str = "grasp") -> tuple[np.ndarray, np.ndarray]:
