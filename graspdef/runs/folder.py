@@ -17,14 +17,14 @@ class OutputFolderError(GraspdefError):
     """An output folder cannot be written (checked before any work)."""
 
 
-def check_output_folder(out: str | PathLike) -> Path:
+def check_output_folder(out: str | PathLike, marker: str = "result.json") -> Path:
     """Refuse, before any heavy work, an output folder that cannot be written or that holds
-    something other than a graspdef run (a run folder is replaced atomically at the end; a folder
-    of other files is never clobbered)."""
+    something other than a graspdef run (a run folder -- one holding ``marker`` -- is replaced
+    atomically at the end; a folder of other files is never clobbered)."""
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise OutputFolderError(f"--out {out} is a file, not a folder")
-    if out.is_dir() and any(out.iterdir()) and not (out / "result.json").is_file():
+    if out.is_dir() and any(out.iterdir()) and not (out / marker).is_file():
         raise OutputFolderError(f"--out {out} holds files that are not a graspdef run folder; give a new or empty "
                                 "folder (a run folder is replaced)")
     parent = out.parent
