@@ -103,32 +103,39 @@ def antipodal_candidates(mesh: TriMesh, centre_of_mass, friction: float, max_wid
     locs, ray_idx, tris = locs[first], ray_idx[first], tris[first]
     cone = math.degrees(math.atan(friction))
     com = np.asarray(centre_of_mass, float)
-    candidates = []
-    for q, i, tq in zip(locs, ray_idx, tris):
-        p = starts[i]
-        w = float(np.linalg.norm(q - p))
-        if not (min_width <= w <= max_width):
-            continue
-        d = (q - p) / w
-        a_p = math.degrees(math.acos(float(np.clip(normals[i] @ -d, -1, 1))))
-        a_q = math.degrees(math.acos(float(np.clip(tm.face_normals[tq] @ d, -1, 1))))
-        angle = max(a_p, a_q)
-        if angle >= cone:
-            continue
-        off = float(np.linalg.norm(np.cross(com - p, d)))      # distance of the line from the COM
-        cost = angle / cone + off / (0.5 * size)
-        candidates.append(((round(cost, 6), int(i)), p.copy(), q.copy(), d, angle))
-    candidates.sort(key=lambda c: c[0])
+    p = starts[ray_idx]
+    w = np.linalg.norm(locs - p, axis=1)
+    keep = (w >= min_width) & (w <= max_width)
+    p, q, w, i, tq = p[keep], locs[keep], w[keep], ray_idx[keep], tris[keep]
+    d = (q - p) / w[:, None]
+    a_p = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", normals[i], -d), -1, 1)))
+    a_q = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", tm.face_normals[tq], d), -1, 1)))
+    angle = np.maximum(a_p, a_q)
+    keep = angle < cone
+    p, q, w, i, d, angle = p[keep], q[keep], w[keep], i[keep], d[keep], angle[keep]
+    # cost: the antipodal angle as a fraction of the friction cone, plus the line's distance from the
+    # centre of mass (the weight's torque) as a fraction of half the object's size
+    off = np.linalg.norm(np.cross(com - p, d), axis=1)
+    cost = np.round(angle / cone + off / (0.5 * size), 6)
+    order = np.lexsort((i, cost))
     out = []
     far = 2.0 * size
-    for _key, p, q, d, angle in candidates:
+    for s0 in range(0, len(order), 512):
+        blk = order[s0: s0 + 512]
         # the fingers come from outside along the line: p and q must be its first and last crossings
-        hits, _, _ = tm.ray.intersects_location([p - far * d], [d], multiple_hits=True)
-        t = (hits - (p - far * d)) @ d
-        if len(t) and t.min() >= far - 1e-4 * size and t.max() <= far + np.linalg.norm(q - p) + 1e-4 * size:
-            out.append(Grasp(p, q, d, angle, "best antipodal pair (automatic)"))
+        origin = p[blk] - far * d[blk]
+        hits, ridx, _ = tm.ray.intersects_location(origin, d[blk], multiple_hits=True)
+        t = np.einsum("ij,ij->i", hits - origin[ridx], d[blk][ridx])
+        lo = np.full(len(blk), np.inf)
+        hi = np.full(len(blk), -np.inf)
+        np.minimum.at(lo, ridx, t)
+        np.maximum.at(hi, ridx, t)
+        ok = np.isfinite(lo) & (lo >= far - 1e-4 * size) & (hi <= far + w[blk] + 1e-4 * size)
+        for k in np.flatnonzero(ok):
+            j = blk[k]
+            out.append(Grasp(p[j].copy(), q[j].copy(), d[j].copy(), float(angle[j]), "best antipodal pair (automatic)"))
             if limit is not None and len(out) >= limit:
-                break
+                return out
     return out
 
 

@@ -1,30 +1,39 @@
 """``graspdef rank OBJECT --force F``: sample antipodal candidates on an object's surface, screen
-them with the linear shell (one factorisation, a back-substitution each) and write the ranked
-table.  The object is a scene folder with its object.toml (``graspdef object add`` makes one)."""
+them with the linear shell (one factorisation, back-substitutions in blocks), rank them and write
+the ranking folder (graspdef.runs.ranking).  The object is a folder with its object.toml
+(``graspdef object add`` makes one), a scene.xml, or a name under scenes/.
+
+Ranking criterion: candidates that hold (deformed friction margin > 0, the weight's torque and
+slip ratios < 1, the strain limit kept when one is given) first, by least work spent deforming
+the object; then the others, by least work.  The rigid baseline ranks by the rest friction margin
+(largest first), then the weight's torque ratio -- what a planner that ignores deformation sees.
+"""
 from __future__ import annotations
 
-import csv
-import json
+import math
 import time
-from pathlib import Path
 
 import numpy as np
+from scipy.stats import spearmanr
 
 from ..errors import ProblemError
 from ..objects import build_shell, load_object, scene_xml
 from ..objects.build import outer_surface
 from ..objects.placement import CLEARANCE, antipodal_candidates
-from ..runs.folder import atomic_folder, check_output_folder
-from ..sim.gripper import OPEN, TRAVEL
-from .screen import LinearScreen, rank
+from ..runs.folder import check_output_folder
+from ..runs.ranking import write_ranking
+from ..sim.gripper import OPEN, TRAVEL, GripperModel
+from .screen import LinearScreen
 
-#: ranking.csv columns and their units
-COLUMNS = ["rank", "candidate", "first_x_m", "first_y_m", "first_z_m", "second_x_m", "second_y_m", "second_z_m",
-           "width_m", "antipodal_angle_deg", "indentation_per_finger_m", "work_J", "grasp_stiffness_N_per_m",
-           "max_displacement_m", "friction_margin_deg", "weight_torque_ratio"]
+#: torsional friction of a fingertip contact [m] (MuJoCo condim 4: torque = this x normal force;
+#: the scenes' 0.005)
+TORSIONAL_FRICTION = 0.005
+G = 9.81
+#: candidates whose linear displacement is stored for the viewer (shapes.npz)
+SHAPES = 50
 
 
-def _scene_facts(xml, body: str) -> tuple[float, np.ndarray, float]:
+def scene_facts(xml, body: str) -> tuple[float, np.ndarray, float]:
     """(mass [kg], centre of mass [m, object frame], Coulomb friction of the fingertip contact:
     MuJoCo combines two geoms' by their maximum) of the scene's object."""
     from ..sim.scene import load_scene
@@ -37,63 +46,192 @@ def _scene_facts(xml, body: str) -> tuple[float, np.ndarray, float]:
     return float(m.body_mass[sc.object_body]), np.array(m.body_ipos[sc.object_body]), max(mu_obj, mu_tip)
 
 
-def rank_object(scene, force: float, candidates: int = 2000, out=None, top: int = 10, progress=None) -> dict:
+def pareto_front(work: np.ndarray, margin: np.ndarray) -> np.ndarray:
+    """Mask of the candidates no other beats in both (less work, larger margin)."""
+    order = np.lexsort((-margin, work))
+    front = np.zeros(len(work), bool)
+    best = -np.inf
+    for i in order:
+        if margin[i] > best:
+            front[i] = True
+            best = margin[i]
+    return front
+
+
+def compliance_map(screen: LinearScreen, max_width: float | None = None, progress=None) -> dict:
+    """Per control vertex: compliance [m/N] of the pinch along its inward normal (unit forces at
+    the vertex's limit point and at the far side's sample where the normal line leaves the
+    surface), its stiffness [N/m] and width [m]; NaN where the line finds no far side or the
+    width exceeds ``max_width``."""
+    import trimesh
+
+    n = screen.n_control
+    # the far side along the normal line, on the outer face of the control vertices' limit points
+    # (a coarse triangulation of the same surface; the hit is then snapped to the nearest sample)
+    faces = screen.shell.mesh.faces[: screen.shell.mesh.n_real_faces]
+    tm = trimesh.Trimesh(screen.outer[:n], faces, process=False)
+    start = screen.outer[:n] - 1e-6 * screen.normal[:n]
+    locs, ray, _ = tm.ray.intersects_location(start, -screen.normal[:n], multiple_hits=True)
+    dist = np.einsum("ij,ij->i", locs - start[ray], -screen.normal[:n][ray])
+    ok = dist > 1e-4 * float(np.ptp(screen.outer, axis=0).max())
+    locs, ray, dist = locs[ok], ray[ok], dist[ok]
+    far = np.full(n, -1)
+    width = np.full(n, np.nan)
+    if len(ray):
+        order = np.lexsort((dist, ray))
+        first = order[np.r_[True, ray[order][1:] != ray[order][:-1]]]
+        j, _ = screen.locate(locs[first])
+        far[ray[first]] = j
+        width[ray[first]] = dist[first]
+    has = (far >= 0) & (far != np.arange(n))
+    if max_width is not None:
+        has &= width <= max_width
+    comp = np.full(n, np.nan)
+    idx = np.flatnonzero(has)
+    if len(idx):
+        fig = screen.evaluate(idx, far[idx], 1.0, progress)
+        comp[idx] = fig.closing_m
+    with np.errstate(divide="ignore", invalid="ignore"):
+        stiff = 1.0 / comp
+    return {"compliance_m_per_N": comp, "stiffness_N_per_m": stiff, "pinch_width_m": np.where(has, width, np.nan)}
+
+
+def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: int = 10,
+                strain_limit: float | None = None, pad_size: float = GripperModel.pad_size,
+                with_map: bool = True, recheck: int = 0, progress=None) -> dict:
     """Rank up to ``candidates`` antipodal grasps of ``scene``'s object at ``force`` [N] per finger;
-    write ``out`` (ranking.csv, ranking.json) when given; return the record (SI)."""
+    write the ranking folder ``out`` when given; return the record (SI).
+
+    ``strain_limit``: the wall's allowed principal strain (e.g. 0.02); ``pad_size`` [m]: the flat
+    pad's edge for the contact-area estimate; ``recheck``: re-run the best k fully nonlinear
+    (graspdef.ranking.recheck); ``progress(stage, info)``."""
     say = progress or (lambda stage, info=None: None)
-    if not (np.isfinite(force) and force > 0):
-        raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
+    if not (isinstance(force, (int, float)) and math.isfinite(force) and force > 0):
+        raise ProblemError(f"--force must be a positive number of newtons, got {force!r}")
     if not 1 <= int(candidates) <= 100_000:
         raise ProblemError(f"--candidates must be 1 to 100,000, got {candidates}")
+    if strain_limit is not None and not (math.isfinite(strain_limit) and 0 < strain_limit < 1):
+        raise ProblemError(f"--strain-limit must be a strain between 0 and 1 (e.g. 0.02 or 2%), got {strain_limit!r}")
+    if not 0 <= int(recheck) <= 50:
+        raise ProblemError(f"--recheck must be 0 to 50 candidates, got {recheck}")
+    GripperModel(tip="pad", pad_size=pad_size)                          # checks the pad size
     if out is not None:
-        check_output_folder(out)
+        check_output_folder(out, "ranking.json")
     t0 = time.perf_counter()
     xml = scene_xml(scene)
     spec = load_object(xml)
-    mass, com, friction = _scene_facts(xml, spec.body)
+    mass, com, friction = scene_facts(xml, spec.body)
     say("candidates")
     outer, _ = outer_surface(spec)
-    cands = antipodal_candidates(outer, com, friction, max_width=2 * (OPEN - CLEARANCE),
-                                 min_width=2 * (OPEN - TRAVEL) + 2 * CLEARANCE, n=int(candidates), seed=0)
-    cands = cands[: int(candidates)]
+    max_width, min_width = 2 * (OPEN - CLEARANCE), 2 * (OPEN - TRAVEL) + 2 * CLEARANCE
+    cands = antipodal_candidates(outer, com, friction, max_width=max_width, min_width=min_width,
+                                 n=int(candidates), seed=0, limit=int(candidates))
     if not cands:
-        raise ProblemError(f"{spec.file}: no antipodal grasp candidates within the gripper's opening and the "
-                           f"friction cone (friction {friction:g})")
+        raise ProblemError(f"{spec.file}: no antipodal grasp candidates {min_width * 1e3:.0f} to {max_width * 1e3:.0f} mm "
+                           f"wide (the gripper's opening) within the friction cone (friction {friction:g})")
     t_cand = time.perf_counter()
     say("factor")
     shell, _ = build_shell(spec, "linear")
-    screen = LinearScreen(shell)
-    t_factor = time.perf_counter()
-    rows = []
+    E, nu = shell.material.E, shell.material.nu
+    screen = LinearScreen(shell, E, nu, pad_radius=0.5 * pad_size)
     try:
-        for i, g in enumerate(cands):
-            rows.append(screen.evaluate(i, g, force, friction, mass, com))
-            say("candidate", {"done": i + 1, "of": len(cands)})
+        t_factor = time.perf_counter()
+        first = np.array([g.first for g in cands])
+        second = np.array([g.second for g in cands])
+        i1, d1 = screen.locate(first)
+        i2, d2 = screen.locate(second)
+        fig = screen.evaluate(i1, i2, force, lambda done, of: say("candidate", {"done": done, "of": len(cands)}))
+        t_screen = time.perf_counter()
+        rows = _rows(cands, fig, force, friction, mass, com, strain_limit)
+        order = [r["candidate"] for r in rows]
+        best = np.array(order[: min(SHAPES, len(order))])
+        U, _, _ = screen.solve(i1[best], i2[best], force)
+        shapes = screen.surface_displacements(U)
+        maps = {"compliance_m_per_N": np.full(screen.n_control, np.nan), "stiffness_N_per_m":
+                np.full(screen.n_control, np.nan), "pinch_width_m": np.full(screen.n_control, np.nan)}
+        if with_map:
+            say("map")
+            maps = compliance_map(screen, max_width=None,
+                                  progress=lambda done, of: say("map", {"done": done, "of": of}))
+        t_map = time.perf_counter()
+        rest = screen.L @ shell.rest_positions
+        faces = shell.mesh.faces[: shell.mesh.n_real_faces]
+        locate_err = float(max(d1.max(), d2.max()))
+        n_samples, level = screen.samples.n, screen.samples.level
     finally:
         screen.close()
-    t_screen = time.perf_counter()
-    ranked = rank(rows)
-    table = [{"rank": k + 1, **r.row()} for k, r in enumerate(ranked)]
-    per_min = 60.0 * len(rows) / (t_screen - t_factor)
+    rho = spearmanr([r["rank"] for r in rows], [r["rigid_rank"] for r in rows]).statistic if len(rows) > 2 else math.nan
     record = {
-        "schema": "graspdef.ranking", "version": 1,
-        "units": {"length": "m", "force": "N", "energy": "J", "stiffness": "N/m", "angle": "deg"},
+        "units": {"length": "m", "force": "N", "energy": "J", "stiffness": "N/m", "angle": "deg", "stress": "Pa",
+                  "area": "m^2"},
         "object": spec.body, "scene": str(xml), "force_N": float(force), "friction": friction, "mass_kg": mass,
-        "centre_of_mass_m": com.tolist(), "material": {"model": "linear_elastic", "E_Pa": spec.material.E,
-                                                       "nu": spec.material.nu},
-        "thickness_m": spec.thickness, "control_vertices": int(shell.mesh.n_real), "n_candidates": len(rows),
-        "ranking": "held candidates (friction margin > 0 and weight torque ratio < 1) first, then least work",
-        "timings_s": {"candidates": t_cand - t0, "factor": t_factor - t_cand, "screen": t_screen - t_factor,
-                      "total": t_screen - t0},
-        "candidates_per_minute": per_min, "top": table[: int(top)],
+        "centre_of_mass_m": com.tolist(), "gravity_m_per_s2": G, "torsional_friction_m": TORSIONAL_FRICTION,
+        "material": {"model": "linear_elastic (the object's small-strain moduli)", "E_Pa": E, "nu": nu,
+                     "law": spec.material.law, "source": spec.material.source},
+        "thickness_m": spec.thickness, "control_vertices": int(shell.mesh.n_real),
+        "samples": {"level": level, "n": int(n_samples),
+                    "largest_contact_to_sample_m": locate_err},
+        "pad_size_m": pad_size, "strain_limit": strain_limit,
+        "n_candidates": len(rows), "candidates_requested": int(candidates),
+        "gripper_opening_m": [min_width, max_width],
+        "ranking": ("held candidates (deformed friction margin > 0, weight torque and slip ratios < 1, strain "
+                    "limit kept) first, by least work spent deforming the object; then the others, by least work"),
+        "rigid_ranking": "rest friction margin (largest first), then the weight's torque ratio (smallest first)",
+        "rank_correlation": {"rigid_vs_deformable_spearman": float(rho)},
+        "n_held": int(sum(r["held"] for r in rows)), "n_pareto": int(sum(r["pareto"] for r in rows)),
+        "timings_s": {"candidates": t_cand - t0, "factor_and_setup": t_factor - t_cand, "screen": t_screen - t_factor,
+                      "map": t_map - t_screen, "total": t_map - t0},
+        "candidates_per_minute": 60.0 * len(rows) / max(t_screen - t_factor, 1e-9),
+        "top": rows[: int(top)],
     }
+    if recheck:
+        from .recheck import recheck_top
+
+        say("recheck")
+        record.update(recheck_top(scene, spec, rows[: int(recheck)], force, progress=say))
     if out is not None:
-        with atomic_folder(out) as tmp:
-            with open(tmp / "ranking.csv", "w", newline="") as fh:
-                w = csv.DictWriter(fh, COLUMNS)
-                w.writeheader()
-                for row in table:
-                    w.writerow({k: (f"{v:.9g}" if isinstance(v, float) else v) for k, v in row.items()})
-            (tmp / "ranking.json").write_text(json.dumps(record, indent=1) + "\n")
-        record["out"] = str(Path(out))
+        write_ranking(out, record, rows, rest, faces, maps, best, shapes)
+        record["out"] = str(out)
     return record
+
+
+def _rows(cands, fig, force, friction, mass, com, strain_limit) -> list[dict]:
+    """The table's rows in rank order (every column of graspdef.runs.ranking.COLUMNS)."""
+    cone = math.degrees(math.atan(friction))
+    n = len(cands)
+    first = np.array([g.first for g in cands])
+    second = np.array([g.second for g in cands])
+    axis = np.array([g.axis for g in cands])
+    angle = np.array([g.angle_deg for g in cands])
+    margin = cone - fig.rest_angle_deg
+    off = np.linalg.norm(np.cross(np.asarray(com) - first, axis), axis=1)
+    torque = mass * G * off / (2.0 * TORSIONAL_FRICTION * force)
+    slip = mass * G / (2.0 * friction * force)
+    dmargin = cone - fig.deformed_angle_deg
+    ratio = fig.peak_strain / strain_limit if strain_limit else np.full(n, np.nan)
+    held = (dmargin > 0) & (torque < 1.0) & (slip < 1.0) & (~(ratio > 1.0))
+    rank_order = np.lexsort((np.arange(n), fig.work_J, ~held))
+    rigid_order = np.lexsort((np.arange(n), torque, -margin))
+    rank = np.empty(n, np.int64)
+    rank[rank_order] = np.arange(1, n + 1)
+    rigid = np.empty(n, np.int64)
+    rigid[rigid_order] = np.arange(1, n + 1)
+    pareto = pareto_front(fig.work_J, dmargin)
+    rows = []
+    for i in rank_order:
+        rows.append({
+            "rank": int(rank[i]), "candidate": int(i),
+            "first_x_m": first[i, 0], "first_y_m": first[i, 1], "first_z_m": first[i, 2],
+            "second_x_m": second[i, 0], "second_y_m": second[i, 1], "second_z_m": second[i, 2],
+            "width_m": float(np.linalg.norm(second[i] - first[i])), "antipodal_angle_deg": float(angle[i]),
+            "friction_margin_deg": float(margin[i]), "rigid_rank": int(rigid[i]),
+            "closing_m": float(fig.closing_m[i]), "indentation_per_finger_m": 0.5 * float(fig.closing_m[i]),
+            "work_J": float(fig.work_J[i]), "strain_energy_J": float(fig.strain_energy_J[i]),
+            "grasp_stiffness_N_per_m": float(fig.stiffness_N_per_m[i]),
+            "max_displacement_m": float(fig.max_displacement_m[i]), "peak_strain": float(fig.peak_strain[i]),
+            "peak_von_mises_Pa": float(fig.peak_von_mises_Pa[i]), "strain_limit_ratio": float(ratio[i]),
+            "contact_area_m2": float(fig.contact_area_m2[i]),
+            "deformed_friction_margin_deg": float(dmargin[i]), "weight_torque_ratio": float(torque[i]),
+            "weight_slip_ratio": float(slip), "held": int(held[i]), "pareto": int(pareto[i]),
+        })
+    return rows

@@ -1,19 +1,28 @@
-"""Where to grasp: a linear screen of many antipodal grasp candidates on an object's shell.
+"""Where to grasp: a linear screen of many antipodal grasp pairs on a closed shell.
 
-One factorisation of the free shell's stiffness at rest (rigid modes removed by orthogonality,
-exact for the self-equilibrated pair of finger forces), then one back-substitution per candidate:
-the finger at ``first`` pushes +F d, the one at ``second`` -F d (d the unit chord from first to
-second).  With b = (load vector of the unit pair), u = F K^-1 b and, per candidate,
+One factorisation of the free shell's stiffness at rest (rigid modes removed by orthogonality:
+exact for a self-equilibrated load), then back-substitutions in blocks of many right-hand sides.
+A pair is two samples of the limit surface (:mod:`graspdef.subdivision.samples`: exact limit
+points with exact weights, spacing edge / 2^level); the finger at the first pushes +F d, the one
+at the second -F d, with d the unit chord between the two samples -- equal, opposite and collinear,
+so the pair is exactly self-equilibrated.  With b the load vector of the unit pair and
+u = F K^-1 b, per pair:
 
-* closing displacement delta = b.u = F b^T K^-1 b (the two contact points' approach [m]),
-  indentation per finger delta / 2, grasp stiffness F / delta [N/m];
-* work spent deforming the object to reach F: W = F delta / 2 = u^T K u / 2 [J] (linear: the
-  strain energy) -- the minimal-work metric of Xu et al. for hollow deformable objects;
-* max displacement over the limit surface [m];
-* the rigid-object baseline: the friction margin atan(mu) - (antipodal angle) [deg] and the
-  weight's torque about the grasp line against the torsional friction of the two contacts.
+* closing displacement delta = b.u (the contact points' approach) [m]; grasp stiffness F/delta;
+* the work spent deforming the object to reach F: W = F delta / 2 [J] -- the minimal-work metric
+  of Xu et al. for hollow deformable objects; the strain energy u.K u / 2 is computed separately
+  (Clapeyron: equal in linear theory, a check);
+* max displacement over the limit surface (control-vertex limit points and the two contacts);
+* peak principal strain and von Mises stress on both faces of the wall
+  (:mod:`graspdef.shell.strains`, at the quadrature points: under a point force they grow as the
+  mesh is refined, a relative figure);
+* the contacts' normals (the mean over the contact patch) and the grasp line after deformation,
+  and the friction margin atan(mu) - (largest angle between a deformed inward normal and the
+  deformed line) [deg]; the same at rest (the rigid baseline's margin, with the same normals);
+* an estimate of the contact area of a flat pad: the rest surface's outer face within the pad's
+  disk that the pad, pressed in by the indentation delta / 2, would overlap [m^2].
 
-Candidates come from :func:`graspdef.objects.placement.antipodal_candidates`.  SI throughout.
+SI throughout.
 """
 from __future__ import annotations
 
@@ -22,87 +31,205 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
 
-from ..objects.placement import Grasp
-from ..problem.loads import PointLoad, load_vector
+from ..errors import ProblemError
 from ..problem.problem import Problem
 from ..problem.supports import RigidModes
+from ..shell.strains import linear_strain_operator
 from ..solve.linear import rest_stiffness
 from ..solve.sparse import KKTSystem
 from ..subdivision.rules import limit_matrix
+from ..subdivision.samples import level_for, limit_samples
 
-#: torsional friction of a fingertip contact [m] (MuJoCo condim 4: torque = this x normal force;
-#: the scenes' 0.005)
-TORSIONAL_FRICTION = 0.005
-G = 9.81
+#: right-hand sides per back-substitution block (memory: 3 n_control x BLOCK doubles, and the
+#: strain operator's 6 n_points x BLOCK)
+BLOCK = 64
 
 
-@dataclass(frozen=True)
-class Screened:
-    """One candidate's linear-screen figures (SI)."""
+@dataclass
+class PairFigures:
+    """Per-pair linear figures (arrays of one length, SI)."""
 
-    index: int
-    grasp: Grasp
-    closing_m: float
-    work_J: float
-    stiffness_N_per_m: float
-    max_displacement_m: float
-    friction_margin_deg: float
-    torque_ratio: float
+    closing_m: np.ndarray
+    work_J: np.ndarray
+    strain_energy_J: np.ndarray
+    stiffness_N_per_m: np.ndarray
+    max_displacement_m: np.ndarray
+    peak_strain: np.ndarray
+    peak_von_mises_Pa: np.ndarray
+    deformed_angle_deg: np.ndarray
+    rest_angle_deg: np.ndarray
+    contact_area_m2: np.ndarray
 
-    def row(self) -> dict:
-        g = self.grasp
-        return {"candidate": self.index, "first_x_m": g.first[0], "first_y_m": g.first[1], "first_z_m": g.first[2],
-                "second_x_m": g.second[0], "second_y_m": g.second[1], "second_z_m": g.second[2],
-                "width_m": g.width, "antipodal_angle_deg": g.angle_deg, "indentation_per_finger_m": self.closing_m / 2,
-                "work_J": self.work_J, "grasp_stiffness_N_per_m": self.stiffness_N_per_m,
-                "max_displacement_m": self.max_displacement_m, "friction_margin_deg": self.friction_margin_deg,
-                "weight_torque_ratio": self.torque_ratio}
+    @classmethod
+    def concat(cls, parts: list["PairFigures"]) -> "PairFigures":
+        return cls(**{k: np.concatenate([getattr(p, k) for p in parts]) for k in cls.__dataclass_fields__})
 
 
 class LinearScreen:
-    """The free shell's stiffness at rest, factorised once; :meth:`evaluate` a candidate per
-    back-substitution."""
+    """The free closed shell's rest stiffness, factorised once, and its limit-surface samples.
 
-    def __init__(self, shell, backend: str = "auto"):
-        self.shell = shell
+    ``shell``: a closed shell (an object's); ``E``, ``nu``: the small-strain moduli for the stress
+    [Pa]; ``pad_radius`` [m]: the flat pad's disk for the contact-area estimate; ``level``:
+    sample refinements (default: ~100k samples)."""
+
+    def __init__(self, shell, E: float, nu: float, pad_radius: float = 0.012, level: int | None = None,
+                 backend: str = "auto"):
+        mesh = shell.mesh
+        if mesh.n_control != mesh.n_real:
+            raise ProblemError("ranking grasps needs a closed object (this shell has a free edge)")
+        t0 = time.perf_counter()
+        self.shell, self.E, self.nu, self.pad_radius = shell, float(E), float(nu), float(pad_radius)
         self.problem = Problem(shell, [], [RigidModes()])
         C, _, _ = self.problem.constraints(with_targets=True)
+        self.K = rest_stiffness(self.problem)
         self.kkt = KKTSystem(C, backend)
-        t = time.perf_counter()
-        self.kkt.factor(rest_stiffness(self.problem))
-        self.seconds_factor = time.perf_counter() - t
-        mesh = shell.mesh
+        self.kkt.factor(self.K)
+        if self.kkt.n_negative is not None and self.kkt.n_negative != self.kkt.m:
+            raise ProblemError(f"the object's rest stiffness is singular beyond its rigid modes ({self.kkt.n_negative} "
+                               f"negative pivots for {self.kkt.m} constraints): a mechanism is free")
+        x = shell.rest_positions
+        self.samples = limit_samples(mesh.faces, mesh.n_control, level_for(mesh.n_control) if level is None else level)
+        self.P = self.samples.points(x)
+        self.normal = self.samples.normals(self.P)
+        # a closed, outward-oriented mesh: the sample normals point outward (checked: the mean of
+        # (P - centroid).n is positive)
+        if float(np.einsum("ij,ij->i", self.P - self.P.mean(0), self.normal).mean()) < 0:
+            self.normal = -self.normal
+        self.area = self.samples.areas(self.P)
+        f = self.samples.faces
+        self.spacing = float(np.linalg.norm(self.P[f[:, 1]] - self.P[f[:, 0]], axis=1).mean())
+        self.half_t = 0.5 * float(np.mean(np.atleast_1d(shell.thickness)))
+        self.outer = self.P + self.half_t * self.normal
+        self.tree = cKDTree(self.P)
+        self.outer_tree = cKDTree(self.outer)
         self.L = limit_matrix(mesh.faces, mesh.n_control, np.arange(mesh.n_real))
-        self.tol = 2.0 * shell.thickness + 0.5 * float(np.linalg.norm(
-            shell.rest_positions[mesh.faces[:, 1]] - shell.rest_positions[mesh.faces[:, 0]], axis=1).mean())
+        self.strain = linear_strain_operator(shell)
+        self.seconds_setup = time.perf_counter() - t0
 
-    def unit_pair(self, g: Grasp) -> np.ndarray:
-        """The load vector of the unit finger pair of ``g`` on the mid-surface (the contacts on the
-        outer surface projected onto it)."""
-        p = self.problem.locate(g.first, "first contact", tol=self.tol)
-        q = self.problem.locate(g.second, "second contact", tol=self.tol)
-        d = tuple(float(c) for c in g.axis)
-        return load_vector(self.shell, [PointLoad(p.face, p.bary, d), PointLoad(q.face, q.bary, tuple(-c for c in d))],
-                           self.problem.evaluator)
+    @property
+    def n_control(self) -> int:
+        return self.shell.mesh.n_control
 
-    def evaluate(self, index: int, g: Grasp, force: float, friction: float, mass: float,
-                 centre_of_mass) -> Screened:
-        b = self.unit_pair(g)
-        u, _, _ = self.kkt.solve(force * b)
-        closing = float(b @ u)                        # = F b^T K^-1 b
-        ul = self.L @ u.reshape(-1, 3)
-        off = float(np.linalg.norm(np.cross(np.asarray(centre_of_mass) - g.first, g.axis)))
-        torque_ratio = mass * G * off / (2.0 * TORSIONAL_FRICTION * force)
-        return Screened(index, g, closing, 0.5 * force * closing, force / closing if closing > 0 else math.inf,
-                        float(np.linalg.norm(ul, axis=1).max()), math.degrees(math.atan(friction)) - g.angle_deg,
-                        torque_ratio)
+    def locate(self, points) -> tuple[np.ndarray, np.ndarray]:
+        """Nearest samples of the mid-surface to contact points on the outer face (k, 3) [m]:
+        (sample indices, distances [m] from the outer face's sample)."""
+        d, i = self.outer_tree.query(np.atleast_2d(np.asarray(points, float)))
+        return i, d
+
+    def unit_pairs(self, i1: np.ndarray, i2: np.ndarray) -> tuple[sp.csc_matrix, np.ndarray]:
+        """(B (3 n_control, k): load vectors of unit pairs, d (k, 3): unit chords first -> second)."""
+        d = self.P[i2] - self.P[i1]
+        w = np.linalg.norm(d, axis=1)
+        if np.any(w <= 0):
+            raise ProblemError("a grasp pair has both contacts at the same point")
+        d = d / w[:, None]
+        W = self.samples.W
+        cols, rows, vals = [], [], []
+        for sign, idx in ((1.0, i1), (-1.0, i2)):
+            sub = W[idx].tocoo()
+            for k in range(3):
+                rows.append(3 * sub.col + k)
+                cols.append(sub.row)
+                vals.append(sign * sub.data * d[sub.row, k])
+        B = sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(self.shell.n_dofs, len(i1)))
+        return B, d
+
+    def solve(self, i1, i2, force: float) -> tuple[np.ndarray, sp.csc_matrix, np.ndarray]:
+        """Displacements U (3 n_control, k) [m] of the pairs at ``force`` [N], with B and d."""
+        B, d = self.unit_pairs(np.asarray(i1), np.asarray(i2))
+        U, _, _ = self.kkt.solve(force * B.toarray())
+        return U, B, d
+
+    def surface_displacements(self, U: np.ndarray) -> np.ndarray:
+        """Displacements (k, n_control, 3) [m] of the control vertices' limit points."""
+        k = U.shape[1]
+        return np.stack([self.L @ U[:, j].reshape(-1, 3) for j in range(k)])
+
+    def _moved(self, idx: np.ndarray, cand: np.ndarray, U3: np.ndarray) -> np.ndarray:
+        """Deformed positions (r, 3) of samples ``idx`` (r,) under candidate ``cand`` (r,)'s field."""
+        if U3 is None:
+            return self.P[idx]
+        sub = self.samples.W[idx].tocoo()
+        u = np.zeros((len(idx), 3))
+        np.add.at(u, sub.row, sub.data[:, None] * U3[sub.col, :, cand[sub.row]])
+        return self.P[idx] + u
+
+    def _deformed_angles(self, i1, i2, U, radius) -> tuple[np.ndarray, np.ndarray]:
+        """(largest angle [deg] between a deformed inward normal and the deformed line,
+        displacement magnitudes at both contacts (k, 2) [m]).
+
+        A contact's normal is the mean normal of the surface over a disk of ``radius`` (k,) [m]
+        about it (the contact patch; at least two sample spacings): the vector area of the hexagon
+        of six samples on the disk's rim, moved by the candidate's displacement.  (The normal at
+        the point of a point force is a discretisation artefact; the patch's mean is not.)"""
+        k = len(i1)
+        cand = np.arange(k)
+        U3 = None if U is None else U.reshape(self.n_control, 3, k)
+        ends = [self._moved(idx, cand, U3) for idx in (i1, i2)]
+        umag = np.stack([np.linalg.norm(e - self.P[idx], axis=1) for e, idx in zip(ends, (i1, i2))], 1)
+        dd = ends[1] - ends[0]
+        dd /= np.linalg.norm(dd, axis=1, keepdims=True)
+        theta = np.arange(6) * (np.pi / 3.0)
+        ang = np.zeros(k)
+        for idx, inward in ((i1, dd), (i2, -dd)):
+            n0 = self.normal[idx]
+            e1 = np.cross(n0, np.where(np.abs(n0[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
+            e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+            e2 = np.cross(n0, e1)
+            rim = (self.P[idx][:, None] + radius[:, None, None] * (np.cos(theta)[None, :, None] * e1[:, None]
+                                                                 + np.sin(theta)[None, :, None] * e2[:, None]))
+            _, j = self.tree.query(rim.reshape(-1, 3))
+            X = self._moved(j, np.repeat(cand, 6), U3).reshape(k, 6, 3)
+            n = np.cross(X, np.roll(X, -1, axis=1)).sum(axis=1)
+            n /= np.linalg.norm(n, axis=1, keepdims=True)
+            n = np.where((np.einsum("ij,ij->i", n, n0) < 0)[:, None], -n, n)
+            cosang = np.clip(np.einsum("ij,ij->i", -n, inward), -1.0, 1.0)
+            ang = np.maximum(ang, np.degrees(np.arccos(cosang)))
+        return ang, umag
+
+    def contact_area(self, idx: np.ndarray, push: np.ndarray, depth: np.ndarray) -> np.ndarray:
+        """Estimate per contact: area of the outer face's samples within the pad's disk (radius
+        ``pad_radius`` about the line through the contact along ``push``) lying within ``depth``
+        [m] of the pad's plane -- the rest surface a rigid flat pad pressed in by ``depth`` overlaps."""
+        out = np.zeros(len(idx))
+        near = self.outer_tree.query_ball_point(self.outer[idx], r=self.pad_radius * math.sqrt(2.0) + 1e-12)
+        for j, (i, nb) in enumerate(zip(idx, near)):
+            nb = np.asarray(nb, dtype=np.int64)
+            rel = self.outer[nb] - self.outer[i]
+            h = rel @ push[j]                                   # how far beyond the pad's rest plane
+            lat = np.linalg.norm(rel - h[:, None] * push[j], axis=1)
+            facing = self.normal[nb] @ push[j] < 0              # the face the pad approaches
+            sel = (lat <= self.pad_radius) & (h <= depth[j]) & facing
+            out[j] = float(self.area[nb[sel]].sum())
+        return out
+
+    def evaluate(self, i1, i2, force: float, progress=None) -> PairFigures:
+        """Figures of the pairs (``i1[j]``, ``i2[j]``) (sample indices) at ``force`` [N] per finger,
+        in blocks of :data:`BLOCK` back-substitutions; ``progress(done, total)`` after each."""
+        i1, i2 = np.asarray(i1, np.int64), np.asarray(i2, np.int64)
+        parts = []
+        for s in range(0, len(i1), BLOCK):
+            a, b = i1[s: s + BLOCK], i2[s: s + BLOCK]
+            U, B, d = self.solve(a, b, force)
+            closing = np.asarray(B.multiply(U).sum(axis=0)).ravel()
+            energy = 0.5 * np.einsum("ij,ij->j", U, self.K @ U)
+            ul = self.surface_displacements(U)
+            peak_e, peak_s = self.strain.peaks(U, self.E, self.nu)
+            area = 0.5 * (self.contact_area(a, d, 0.5 * closing) + self.contact_area(b, -d, 0.5 * closing))
+            radius = np.maximum(np.sqrt(area / np.pi), 2.0 * self.spacing)
+            ang, ucontact = self._deformed_angles(a, b, U, radius)
+            ang0, _ = self._deformed_angles(a, b, None, radius)
+            maxu = np.maximum(np.linalg.norm(ul, axis=2).max(axis=1), ucontact.max(axis=1))
+            parts.append(PairFigures(closing, 0.5 * force * closing, energy,
+                                     np.where(closing > 0, force / np.where(closing > 0, closing, 1.0), np.inf),
+                                     maxu, peak_e, peak_s, ang, ang0, area))
+            if progress is not None:
+                progress(min(s + BLOCK, len(i1)), len(i1))
+        return PairFigures.concat(parts)
 
     def close(self) -> None:
         self.kkt.close()
-
-
-def rank(rows: list[Screened]) -> list[Screened]:
-    """Held candidates (friction margin > 0, weight's torque below the contacts' torsional friction)
-    first, by least work; then the others, by least work."""
-    return sorted(rows, key=lambda r: (not (r.friction_margin_deg > 0 and r.torque_ratio < 1.0), r.work_J, r.index))

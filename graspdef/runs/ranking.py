@@ -41,8 +41,10 @@ COLUMNS = [
     ("first_x_m", "m", "first contact, object frame"), ("first_y_m", "m", ""), ("first_z_m", "m", ""),
     ("second_x_m", "m", "second contact"), ("second_y_m", "m", ""), ("second_z_m", "m", ""),
     ("width_m", "m", "distance between the contacts (the gripper's opening at contact)"),
-    ("antipodal_angle_deg", "deg", "rigid: larger angle between a contact's inward normal and the grasp line"),
-    ("friction_margin_deg", "deg", "rigid baseline: atan(friction) - antipodal angle (> 0: inside the cone)"),
+    ("antipodal_angle_deg", "deg", "larger angle between a contact's inward normal (the outer mesh's face) and "
+                                   "the grasp line, as sampled"),
+    ("friction_margin_deg", "deg", "rigid baseline: atan(friction) - the larger angle between a contact patch's "
+                                   "mean inward normal and the line, at rest (> 0: inside the cone)"),
     ("rigid_rank", "", "rank of the rigid-object baseline (friction margin, then weight torque ratio)"),
     ("closing_m", "m", "linear: approach of the two contact points along the grasp line at the force"),
     ("indentation_per_finger_m", "m", "closing / 2"),
@@ -55,8 +57,8 @@ COLUMNS = [
     ("strain_limit_ratio", "", "peak strain / the given strain limit (NaN: no limit given)"),
     ("contact_area_m2", "m^2", "estimate per finger: the flat pad pressed by the indentation into the rest "
                                "surface (geometric overlap), mean of the two fingers"),
-    ("deformed_friction_margin_deg", "deg", "atan(friction) - angle between the deformed contact normals and "
-                                            "the deformed grasp line"),
+    ("deformed_friction_margin_deg", "deg", "the same after the linear deformation: the patches' mean normals "
+                                            "and the line through the moved contacts"),
     ("weight_torque_ratio", "", "weight's torque about the grasp line (gravity across it) / torsional friction "
                                 "of the two contacts"),
     ("weight_slip_ratio", "", "weight / tangential friction of the two contacts: m g / (2 friction F)"),
