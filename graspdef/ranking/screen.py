@@ -158,38 +158,62 @@ class LinearScreen:
         np.add.at(u, sub.row, sub.data[:, None] * U3[sub.col, :, cand[sub.row]])
         return self.P[idx] + u
 
-    def _deformed_angles(self, i1, i2, U, radius) -> tuple[np.ndarray, np.ndarray]:
-        """(largest angle [deg] between a deformed inward normal and the deformed line,
-        displacement magnitudes at both contacts (k, 2) [m]).
+    def _patch_boundary(self, idx: np.ndarray, radius: np.ndarray):
+        """Boundary of each contact's patch -- the sample faces with every corner within
+        ``radius`` of sample ``idx[c]`` -- as directed edges (owner c, i, j) oriented with the faces.
+        The patch's vector area is 1/2 sum x_i x x_j over them (Stokes): its mean normal."""
+        f, vf = self.samples.faces, self.samples.vertex_faces
+        near = self.tree.query_ball_point(self.P[idx], r=radius)
+        owner, ei, ej = [], [], []
+        inside = np.zeros(self.samples.n, bool)
+        for c, nb in enumerate(near):
+            nb = np.asarray(nb, dtype=np.int64)
+            inside[nb] = True
+            cand = np.unique(vf[nb].indices)
+            fc = f[cand[inside[f[cand]].all(axis=1)]]
+            inside[nb] = False
+            e = np.concatenate([fc[:, [0, 1]], fc[:, [1, 2]], fc[:, [2, 0]]])
+            key = e[:, 0] * self.samples.n + e[:, 1]
+            rev = e[:, 1] * self.samples.n + e[:, 0]
+            b = e[~np.isin(key, rev)]
+            owner.append(np.full(len(b), c))
+            ei.append(b[:, 0])
+            ej.append(b[:, 1])
+        return np.concatenate(owner), np.concatenate(ei), np.concatenate(ej)
 
-        A contact's normal is the mean normal of the surface over a disk of ``radius`` (k,) [m]
-        about it (the contact patch; at least two sample spacings): the vector area of the hexagon
-        of six samples on the disk's rim, moved by the candidate's displacement.  (The normal at
-        the point of a point force is a discretisation artefact; the patch's mean is not.)"""
+    def _deformed_angles(self, i1, i2, U, radius) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(largest angle [deg] between a deformed inward normal and the deformed line, the same
+        at rest, displacement magnitudes at both contacts (k, 2) [m]).
+
+        A contact's normal is the mean normal of the surface over the patch of ``radius`` (k,) [m]
+        about it (at least two sample spacings): the patch's vector area, from its boundary moved
+        by the candidate's displacement.  (The normal at the point of a point force is a
+        discretisation artefact; the patch's mean is not, and it is invariant under the mesh's
+        symmetries.)"""
         k = len(i1)
         cand = np.arange(k)
-        U3 = None if U is None else U.reshape(self.n_control, 3, k)
+        U3 = U.reshape(self.n_control, 3, k)
         ends = [self._moved(idx, cand, U3) for idx in (i1, i2)]
         umag = np.stack([np.linalg.norm(e - self.P[idx], axis=1) for e, idx in zip(ends, (i1, i2))], 1)
-        dd = ends[1] - ends[0]
-        dd /= np.linalg.norm(dd, axis=1, keepdims=True)
-        theta = np.arange(6) * (np.pi / 3.0)
-        ang = np.zeros(k)
-        for idx, inward in ((i1, dd), (i2, -dd)):
-            n0 = self.normal[idx]
-            e1 = np.cross(n0, np.where(np.abs(n0[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
-            e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
-            e2 = np.cross(n0, e1)
-            rim = (self.P[idx][:, None] + radius[:, None, None] * (np.cos(theta)[None, :, None] * e1[:, None]
-                                                                 + np.sin(theta)[None, :, None] * e2[:, None]))
-            _, j = self.tree.query(rim.reshape(-1, 3))
-            X = self._moved(j, np.repeat(cand, 6), U3).reshape(k, 6, 3)
-            n = np.cross(X, np.roll(X, -1, axis=1)).sum(axis=1)
-            n /= np.linalg.norm(n, axis=1, keepdims=True)
-            n = np.where((np.einsum("ij,ij->i", n, n0) < 0)[:, None], -n, n)
-            cosang = np.clip(np.einsum("ij,ij->i", -n, inward), -1.0, 1.0)
-            ang = np.maximum(ang, np.degrees(np.arccos(cosang)))
-        return ang, umag
+        angles = []
+        for field, (p1, p2) in ((U3, ends), (None, (self.P[i1], self.P[i2]))):
+            dd = p2 - p1
+            dd /= np.linalg.norm(dd, axis=1, keepdims=True)
+            ang = np.zeros(k)
+            for idx, inward in ((i1, dd), (i2, -dd)):
+                owner, bi, bj = self._patch_boundary(idx, radius)
+                xi = self._moved(bi, owner, field)
+                xj = self._moved(bj, owner, field)
+                n = np.zeros((k, 3))
+                np.add.at(n, owner, np.cross(xi, xj))
+                n /= np.linalg.norm(n, axis=1, keepdims=True)
+                n = np.where((np.einsum("ij,ij->i", n, self.normal[idx]) < 0)[:, None], -n, n)
+                # atan2(|n x d|, n.d): accurate near 0, where arccos loses half the digits
+                a = np.degrees(np.arctan2(np.linalg.norm(np.cross(-n, inward), axis=1),
+                                          np.einsum("ij,ij->i", -n, inward)))
+                ang = np.maximum(ang, a)
+            angles.append(ang)
+        return angles[0], angles[1], umag
 
     def contact_area(self, idx: np.ndarray, push: np.ndarray, depth: np.ndarray) -> np.ndarray:
         """Estimate per contact: area of the outer face's samples within the pad's disk (radius
@@ -221,8 +245,7 @@ class LinearScreen:
             peak_e, peak_s = self.strain.peaks(U, self.E, self.nu)
             area = 0.5 * (self.contact_area(a, d, 0.5 * closing) + self.contact_area(b, -d, 0.5 * closing))
             radius = np.maximum(np.sqrt(area / np.pi), 2.0 * self.spacing)
-            ang, ucontact = self._deformed_angles(a, b, U, radius)
-            ang0, _ = self._deformed_angles(a, b, None, radius)
+            ang, ang0, ucontact = self._deformed_angles(a, b, U, radius)
             maxu = np.maximum(np.linalg.norm(ul, axis=2).max(axis=1), ucontact.max(axis=1))
             parts.append(PairFigures(closing, 0.5 * force * closing, energy,
                                      np.where(closing > 0, force / np.where(closing > 0, closing, 1.0), np.inf),
