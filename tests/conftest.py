@@ -128,3 +128,10 @@ def write_synthetic_ranking(out, n_candidates: int = FIXTURE_N_CANDIDATES, n_sha
 def synthetic_ranking(tmp_path_factory):
     """A ranking folder of made-up numbers (see write_synthetic_ranking); do not modify it: copy it."""
     return write_synthetic_ranking(tmp_path_factory.mktemp("ranking") / "fixture_rank")
+
+
+@pytest.fixture(scope="session")
+def ranking_writer():
+    """write_synthetic_ranking, for tests that need a variant (the per-folder conftest modules share
+    the name 'conftest', so tests take it as a fixture instead of importing it)."""
+    return write_synthetic_ranking
