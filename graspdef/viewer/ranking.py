@@ -3,8 +3,10 @@
 Left: the limit surface coloured by the compliance map (log scale, mm/N; grey where no pinch
 fits), with the best candidates as line segments from the first to the second contact, coloured
 by rank (green best, red worst; at most ``top`` drawn, the GUI says how many of how many).
-Right: the deformed shape (rest + magnification x displacement) of one of the candidates stored
-in shapes.npz, picked in a dropdown by rank, coloured by |u| (mm), and that row's figures.
+The contacts are dots on the surface too (the segments run through the object: the surface can be
+drawn translucent or hidden).  Right: the deformed shape (rest + magnification x displacement) of
+one of the candidates stored in shapes.npz, picked in a dropdown by rank, coloured by |u| (mm), with
+two arrows for the fingers (ending where the nearest vertex moved), and that row's figures.
 
 Everything shown comes from :func:`graspdef.runs.ranking.read_ranking` as written: ranks, flags
 and figures are the table's, never recomputed here.  viser is imported when a viewer starts.
@@ -24,6 +26,9 @@ from .server import ViewerError, _import_viser, check_port
 
 #: how many candidates are drawn as segments by default (the best ones)
 DEFAULT_TOP = 200
+#: how the limit surface is drawn: coloured by the compliance map, translucent grey (the segments
+#: inside the object show), or not at all
+SURFACE_MODES = ("compliance map", "translucent", "hidden")
 #: gap between the compliance map and the deformed shape [display units; the object is ~1]
 GAP = 0.45
 MM = 1e3
@@ -164,6 +169,14 @@ class RankingViewer:
             "/ranking/candidates", seg.astype(np.float32), np.repeat(self.segment_colours[:, None, :], 2, axis=1),
             thickness=0.004)
         self.drawn_ranks = r.table["rank"][: self.n_drawn].copy()
+        # the contacts as dots: on the surface, so seen through the opaque map (the segments run inside)
+        dots = np.concatenate([seg[:, 0], seg[:, 1]]).astype(np.float32)
+        self.contacts_handle = scene.add_point_cloud("/ranking/contacts", dots,
+                                                     np.concatenate([self.segment_colours] * 2),
+                                                     point_size=0.018, point_shape="circle")
+        self.translucent_handle = scene.add_mesh_simple("/ranking/translucent", self.surface_vertices, r.faces,
+                                                        color=(170, 170, 170), opacity=0.3, side="double",
+                                                        visible=False)
 
         lo_d, hi_d = self.surface_vertices.min(0), self.surface_vertices.max(0)
         scene.add_label("/ranking/title_map", "compliance map, candidates", anchor="top-center",
@@ -174,11 +187,15 @@ class RankingViewer:
         drawn_text = (f"all {r.n} candidates" if self.n_drawn == r.n else
                       f"the best {self.n_drawn} of {r.n} candidates")
         self.segments_note = gui.add_markdown(
-            f"Segments: {drawn_text}, first → second contact, coloured by rank "
-            f"(green: rank 1 … red: rank {int(self.drawn_ranks[-1]) if self.n_drawn else 0}).")
+            f"Segments: {drawn_text}, first → second contact (dots: the contacts), coloured by rank "
+            f"(green: rank 1 … red: rank {int(self.drawn_ranks[-1]) if self.n_drawn else 0}). The segments run "
+            "through the object: surface 'translucent' shows them.")
         gui.add_html(layers.legend_html("rank", "1 = best", 1.0, float(max(self.n_drawn, 1)), layers.RANKS))
         self.segments_check = gui.add_checkbox("show candidates", True)
         self.segments_check.on_update(lambda _: self._segments_visibility())
+        self.surface_dropdown = gui.add_dropdown("surface", SURFACE_MODES, initial_value=SURFACE_MODES[0],
+                                                 hint="the segments run through the object: 'translucent' shows them")
+        self.surface_dropdown.on_update(lambda _: self._surface_mode())
 
         # the stored shapes, by rank
         rank_of = {int(c): int(k) for c, k in zip(r.table["candidate"], r.table["rank"])}
@@ -234,7 +251,12 @@ class RankingViewer:
         return "\n\n".join(bits)
 
     def _segments_visibility(self) -> None:
-        self.segments_handle.visible = bool(self.segments_check.value)
+        self.segments_handle.visible = self.contacts_handle.visible = bool(self.segments_check.value)
+
+    def _surface_mode(self) -> None:
+        mode = self.surface_dropdown.value
+        self.surface_handle.visible = mode == "compliance map"
+        self.translucent_handle.visible = mode == "translucent"
 
     # ---- picking a stored candidate ----------------------------------------------------------------
     def _on_pick(self) -> None:
@@ -277,10 +299,13 @@ class RankingViewer:
             self.shape_handle = self._mesh("/ranking/deformed", verts, layers.colormap(mags, 0.0, vmax))
             i = self._row_of[self.candidate]
             first, second = r.contacts()
-            seg = layers.segments(self.to_display(first[i:i + 1], self.offset),
-                                  self.to_display(second[i:i + 1], self.offset))
-            self.picked_handle = self.server.scene.add_line_segments(
-                "/ranking/picked", seg.astype(np.float32), (30, 30, 30), thickness=0.008)
+            ends = np.stack([first[i], second[i]])                    # [m]
+            near = np.argmin(np.linalg.norm(r.vertices[None] - ends[:, None], axis=2), axis=1)
+            tips = self.to_display(ends + mag * u[near], self.offset)  # moved like the nearest vertex
+            inward = np.array([second[i] - first[i], first[i] - second[i]])
+            self.picked_handle = self.server.scene.add_arrows(
+                "/ranking/picked", layers.force_arrows(tips, inward, 0.25).astype(np.float32), (40, 40, 40),
+                shaft_radius=0.006, head_radius=0.016, head_length=0.04)
             lo = verts.min(0)
             self.server.scene.add_label(
                 "/ranking/title_shape", f"rank {self.row['rank']}: deformed × {mag:g}", anchor="top-center",
@@ -302,4 +327,4 @@ def view_ranking(folder, host: str = "127.0.0.1", port: int = 8080, block: bool 
     return v
 
 
-__all__ = ["DEFAULT_TOP", "RankingViewer", "row_markdown", "view_ranking"]
+__all__ = ["DEFAULT_TOP", "SURFACE_MODES", "RankingViewer", "row_markdown", "view_ranking"]

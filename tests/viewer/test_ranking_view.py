@@ -32,8 +32,16 @@ def test_segments_capped_and_coloured_by_rank(synthetic_ranking):
         np.testing.assert_array_equal(cols[0, 0], layers.RANKS[0])     # rank 1: green
         np.testing.assert_array_equal(cols[-1, 1], layers.RANKS[-1])   # rank 200: red
         assert "the best 200 of 240 candidates" in v.segments_note.content
+        dots = v.contacts_handle.points                              # both contacts of every drawn candidate
+        assert dots.shape == (400, 3)
+        np.testing.assert_allclose(dots[:200], pts[:, 0], atol=1e-3)   # float16 on the wire
         v.segments_check.value = False
-        assert not v.segments_handle.visible
+        assert not v.segments_handle.visible and not v.contacts_handle.visible
+        assert v.surface_handle.visible and not v.translucent_handle.visible
+        v.surface_dropdown.value = "translucent"                       # the segments inside show
+        assert not v.surface_handle.visible and v.translucent_handle.visible
+        v.surface_dropdown.value = "hidden"
+        assert not v.surface_handle.visible and not v.translucent_handle.visible
     with RankingViewer(synthetic_ranking, port=0, top=40) as v:
         assert v.segments_handle.points.shape == (40, 2, 3)
         assert "the best 40 of 240" in v.segments_note.content
