@@ -1,21 +1,25 @@
-"""``graspdef report RUN_DIR [RUN_DIR ...] [--out FILE] [--scan ID_or_FILE] [--table FILE]``."""
+"""``graspdef report RUN_DIR [RUN_DIR ...] [--out FILE] [--scan ID_or_FILE] [--table FILE]``, or
+``graspdef report RANK_DIR [--out FILE]`` for a ranking folder (graspdef rank --out)."""
 from __future__ import annotations
 
 import argparse
 
 from ._common import progress, warn
 
-HELP = "write a self-contained HTML report of run folders (report.html)"
+HELP = "write a self-contained HTML report of run folders or of a ranking folder (report.html)"
 DESCRIPTION = ("One HTML page (pictures inlined, no external URL): the deformed surface coloured by displacement and "
                "by scan error, load-deflection and convergence plots, and a table in the layout of Tian & Jia's "
-               "Table I for several grasp runs.")
+               "Table I for several grasp runs. A ranking folder (graspdef rank --out) gets its own page: summary, top ten, "
+               "compliance map, Pareto front, rigid baseline, nonlinear re-check; figures also as PNG files beside it.")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The ``report`` sub-command's arguments (call on the sub-parser)."""
     p.add_argument("run_dirs", nargs="*", metavar="RUN_DIR",
-                   help="run folders (graspdef solve/grasp --out); several grasp runs make the Table I comparison")
-    p.add_argument("--out", help="HTML file to write (default: RUN_DIR/report.html of the first run)")
+                   help="run folders (graspdef solve/grasp --out); several grasp runs make the Table I comparison; "
+                        "or one ranking folder (graspdef rank --out)")
+    p.add_argument("--out", help="HTML file to write (default: RUN_DIR/report.html of the first run; a ranking's "
+                                  "figures go to <stem>_figures/ beside it)")
     p.add_argument("--scan", metavar="ID_or_FILE",
                    help="score every run against this scan first (a scan file or a scans/manifest.toml id); "
                         "written to RUN_DIR/score")

@@ -21,8 +21,6 @@ from __future__ import annotations
 import csv
 import datetime
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
@@ -31,6 +29,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import GraspdefError
+from ..runs.ranking import is_ranking
 from ..runs.read import RunData, read_run
 from . import html as H
 from .plots import bar_chart, line_chart, load_deflection, newton_iterations
@@ -431,7 +430,9 @@ def build_report(run_dirs, out: str | PathLike | None = None, *, scan: str | Non
                  surface_offset_mm: float | None = None, scan_units: str | None = None, progress=None,
                  flagged: list | None = None) -> Path:
     """Write the report of ``run_dirs`` (and of the runs of a ``table`` file) to ``out``
-    (default ``RUN_DIR/report.html`` of the first run), atomically; return its path.
+    (default ``RUN_DIR/report.html`` of the first run), atomically; return its path.  A ranking
+    folder (``graspdef rank --out``) is reported on its own by
+    :func:`graspdef.report.ranking.build_ranking_report`.
 
     ``scan``: a scan file or manifest id to score every run against first (``RUN_DIR/score``).
     Raises a GraspdefError subclass (``RunFolderError``, ``ReportError``, ``RegistrationError``)
@@ -439,6 +440,16 @@ def build_report(run_dirs, out: str | PathLike | None = None, *, scan: str | Non
     nothing is written then.  ``flagged``: a list that receives ``(run folder, flags)`` of every
     flagged score (the page shows them too)."""
     say = progress or (lambda m: None)
+    if isinstance(run_dirs, (str, PathLike)):
+        run_dirs = [run_dirs]
+    rankings = [d for d in (run_dirs or []) if is_ranking(d)]
+    if rankings:                                  # a ranking folder (graspdef rank): its own page
+        if len(run_dirs) > 1 or table is not None or scan is not None:
+            raise ReportError(f"{rankings[0]} is a ranking folder: report it on its own (graspdef report RANK_DIR "
+                              "[--out FILE] [--title T]; no other folders, --table or --scan)")
+        from .ranking import build_ranking_report
+
+        return build_ranking_report(rankings[0], out, title=title, views=views, progress=progress)
     entries: list[tuple[Path, float | None, float | None]] = [(Path(d), None, None) for d in (run_dirs or [])]
     if table is not None:
         entries += read_table_file(table)
@@ -484,18 +495,7 @@ def build_report(run_dirs, out: str | PathLike | None = None, *, scan: str | Non
     stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     text = H.page(title, body, subtitle=f"written {stamp} by graspdef report from "
                                         + ", ".join(str(rr.run.path) for rr in runs))
-    fd, tmp = tempfile.mkstemp(prefix=".report-", suffix=".html.tmp", dir=out_path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, out_path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return out_path
+    return H.write_page(out_path, text)
 
 
 __all__ = ["PAPER_TABLE_I", "ReportError", "RunReport", "build_report", "load_run", "read_table_file",

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import base64
 import html as _html
+import os
+import tempfile
 from collections.abc import Sequence
+from pathlib import Path
 
 CSS = """
 body{font-family:-apple-system,"Segoe UI",Helvetica,Arial,sans-serif;margin:24px auto;max-width:1180px;
@@ -77,3 +80,21 @@ def page(title: str, body: Sequence[str], subtitle: str = "") -> str:
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             f"<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>{esc(title)}</title>"
             f"<style>{CSS}</style></head><body><h1>{esc(title)}</h1>{sub}\n" + "\n".join(body) + "\n</body></html>\n")
+
+
+def write_page(out_path: Path, text: str) -> Path:
+    """Write ``text`` to ``out_path`` atomically: a temporary file beside it, renamed into place
+    (a failed write leaves the previous file as it was); the file gets the umask's permissions."""
+    out_path = Path(out_path)
+    fd, tmp = tempfile.mkstemp(prefix=".report-", suffix=".html.tmp", dir=out_path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, out_path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return out_path

@@ -1,5 +1,6 @@
 """Report plots as PNG bytes (matplotlib Agg, object-oriented API only): load-deflection and
-Newton iterations along a load path, grouped bar charts, force-displacement lines."""
+Newton iterations along a load path, grouped bar charts, force-displacement lines; for ranking folders
+the Pareto front of work and friction margin and one rank against another."""
 from __future__ import annotations
 
 import io
@@ -106,4 +107,48 @@ def newton_iterations(load: np.ndarray, iterations: np.ndarray, *, load_label: s
     ax.set_ylabel("Newton iterations")
     ax.grid(axis="y", alpha=0.3)
     ax.set_title(title, fontsize=10)
+    return _png(fig)
+
+
+def pareto_plot(work_mJ: np.ndarray, margin_deg: np.ndarray, held: np.ndarray, pareto: np.ndarray, *,
+                title: str = "work vs deformed friction margin") -> tuple[bytes, np.ndarray]:
+    """Every candidate as a grey point, the held ones coloured, the rows flagged ``pareto`` joined
+    (in order of work) as the front.  Returns the PNG and the front's points (x, y) as drawn."""
+    x, y = np.asarray(work_mJ, float), np.asarray(margin_deg, float)
+    held, front = np.asarray(held) == 1, np.asarray(pareto) == 1
+    fig = _figure(5.2, 3.6)
+    ax = fig.add_subplot(1, 1, 1)
+    ax.scatter(x[~held], y[~held], s=9, c="#b0b0b0", label=f"not held ({int((~held).sum())})", zorder=1)
+    ax.scatter(x[held], y[held], s=12, c=COLOURS[0], label=f"held ({int(held.sum())})", zorder=2)
+    order = np.argsort(x[front], kind="stable")
+    (line,) = ax.plot(x[front][order], y[front][order], "-o", color=COLOURS[1], ms=5, mfc="none", mew=1.4, lw=1.4,
+                      label=f"Pareto front ({int(front.sum())})", zorder=3)
+    ax.axhline(0.0, color="#555555", lw=0.7, ls=":")
+    ax.set_xlabel("work [mJ]")
+    ax.set_ylabel("deformed friction margin [deg]")
+    ax.grid(alpha=0.3)
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=8)
+    return _png(fig), np.asarray(line.get_xydata(), float)
+
+
+def rank_scatter(rank: np.ndarray, other_rank: np.ndarray, held: np.ndarray | None = None, *, xlabel: str,
+                 ylabel: str, title: str = "") -> bytes:
+    """One rank against another (one point per candidate, the diagonal dashed; held ones coloured)."""
+    x, y = np.asarray(rank, float), np.asarray(other_rank, float)
+    fig = _figure(4.4, 4.0)
+    ax = fig.add_subplot(1, 1, 1)
+    h = np.ones(len(x), bool) if held is None else np.asarray(held) == 1
+    ax.scatter(x[~h], y[~h], s=8, c="#b0b0b0", label="not held")
+    ax.scatter(x[h], y[h], s=10, c=COLOURS[0], label="held" if held is not None else None)
+    top = float(max(x.max(initial=1.0), y.max(initial=1.0)))
+    ax.plot([1, top], [1, top], ls="--", color="#555555", lw=0.8)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.3)
+    if title:
+        ax.set_title(title, fontsize=10)
+    if held is not None:
+        ax.legend(fontsize=8)
     return _png(fig)

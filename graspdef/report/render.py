@@ -60,6 +60,13 @@ def _resolve_views(views) -> list[tuple[str, float, float]]:
     return out
 
 
+def _log_ticks(vmin: float, vmax: float) -> list[float]:
+    """1, 2, 5 x 10^k inside [vmin, vmax] (positive); with the two ends when fewer than three fall inside."""
+    ticks = [m * 10.0 ** e for e in range(int(np.floor(np.log10(vmin))), int(np.ceil(np.log10(vmax))) + 1)
+             for m in (1, 2, 5) if vmin * (1 - 1e-9) <= m * 10.0 ** e <= vmax * (1 + 1e-9)]
+    return ticks if len(ticks) >= 3 else sorted(set([float(vmin), *ticks, float(vmax)]))
+
+
 def face_values(scalars: np.ndarray, n_vertices: int, faces: np.ndarray) -> np.ndarray:
     """Per-face values (m,) from per-vertex (n,) scalars (the mean of the corners) or per-face ones."""
     s = np.asarray(scalars, dtype=np.float64).ravel()
@@ -76,7 +83,9 @@ def render_surface(vertices: np.ndarray, faces: np.ndarray, scalars: np.ndarray 
                    title: str = "", vmin: float | None = None, vmax: float | None = None,
                    symmetric: bool = False, panel_size: float = 3.2, dpi: int = 110,
                    colour: str = "#b8c4d6", light: Sequence[float] = (0.35, -0.5, 0.8),
-                   cull: bool | None = None, edges: bool = False, view_titles: bool = True) -> bytes:
+                   cull: bool | None = None, edges: bool = False, view_titles: bool = True,
+                   log: bool = False, segments: np.ndarray | None = None, segment_colours=None,
+                   segment_labels: Sequence[str] | None = None) -> bytes:
     """Render a triangle mesh from one or more view directions into one PNG.
 
     Parameters
@@ -110,6 +119,13 @@ def render_surface(vertices: np.ndarray, faces: np.ndarray, scalars: np.ndarray 
         Drop faces turned away from the viewer; default: only if the mesh is closed.
     edges : bool
         Draw the triangle edges (thin dark lines; for coarse meshes).
+    log : bool
+        Colour on a log scale (positive scalars; others are drawn grey like NaN).
+    segments : ndarray, shape (k, 2, 3), optional
+        Line segments in the vertices' coordinates, drawn **on top** of the surface in every view
+        (not hidden by it: a segment between two surface points shows through the object), with
+        dots at both ends; ``segment_colours`` (k colours, default black) and ``segment_labels``
+        (k strings, written at the first end).
 
     Returns
     -------
@@ -119,7 +135,8 @@ def render_surface(vertices: np.ndarray, faces: np.ndarray, scalars: np.ndarray 
     from matplotlib import colormaps
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.collections import PolyCollection
-    from matplotlib.colors import Normalize, to_rgba
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import LogNorm, Normalize, to_rgba
     from matplotlib.figure import Figure
     from matplotlib.cm import ScalarMappable
 
@@ -137,6 +154,8 @@ def render_surface(vertices: np.ndarray, faces: np.ndarray, scalars: np.ndarray 
     fv = None if scalars is None else face_values(scalars, len(v), f)
     norm = None
     cm = colormaps[cmap]
+    if fv is not None and log:
+        fv = np.where(fv > 0, fv, np.nan)
     if fv is not None:
         finite = fv[np.isfinite(fv)]
         lo = float(finite.min()) if vmin is None and finite.size else (vmin if vmin is not None else 0.0)
@@ -146,7 +165,7 @@ def render_surface(vertices: np.ndarray, faces: np.ndarray, scalars: np.ndarray 
             lo, hi = -m, m
         if not hi > lo:
             hi = lo + (abs(lo) * 1e-6 or 1e-12)
-        norm = Normalize(lo, hi)
+        norm = LogNorm(lo, hi) if log else Normalize(lo, hi)
         base = cm(norm(np.nan_to_num(fv, nan=lo)))
         base[~np.isfinite(fv)] = to_rgba("#999999")
     else:
@@ -190,6 +209,16 @@ def render_surface(vertices: np.ndarray, faces: np.ndarray, scalars: np.ndarray 
         pc = PolyCollection(xy[order], facecolors=rgba, edgecolors=rgba if not edges else "#00000055",
                             linewidths=0.25 if not edges else 0.3, antialiaseds=False)
         ax.add_collection(pc)
+        if segments is not None and len(segments):
+            rs = (np.asarray(segments, dtype=np.float64).reshape(-1, 2, 3) - centre) / radius
+            sxy = np.stack([rs @ right, rs @ up], axis=-1)         # (k, 2, 2)
+            sc = "#000000" if segment_colours is None else segment_colours
+            ax.add_collection(LineCollection(sxy, colors=sc, linewidths=1.4, zorder=3))
+            ends = sxy.reshape(-1, 2)
+            ec = sc if isinstance(sc, str) else np.repeat(np.asarray(sc), 2, axis=0)
+            ax.scatter(ends[:, 0], ends[:, 1], s=7, c=ec, edgecolors="#000000", linewidths=0.3, zorder=4)
+            for lab, (x0, y0) in zip(segment_labels or (), sxy[:, 0]):
+                ax.annotate(str(lab), (x0, y0), fontsize=6, xytext=(2, 2), textcoords="offset points", zorder=5)
         if view_titles and n_views > 1:
             ax.set_title(name, fontsize=8, pad=1)
     if fv is not None:
@@ -197,6 +226,12 @@ def render_surface(vertices: np.ndarray, faces: np.ndarray, scalars: np.ndarray 
         sm = ScalarMappable(norm=norm, cmap=cm)
         cb = fig.colorbar(sm, cax=cax)
         cb.ax.tick_params(labelsize=7)
+        if log:                                  # 1-2-5 ticks as plain numbers (short ranges included)
+            from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
+
+            cb.ax.yaxis.set_major_locator(FixedLocator(_log_ticks(norm.vmin, norm.vmax)))
+            cb.ax.yaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:.3g}"))
+            cb.ax.yaxis.set_minor_locator(NullLocator())
         if label:
             cb.set_label(label, fontsize=8)
     if title:

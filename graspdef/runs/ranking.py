@@ -19,6 +19,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import zipfile
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
@@ -161,28 +162,43 @@ def read_ranking(folder: str | PathLike) -> Ranking:
         record = json.loads((folder / "ranking.json").read_text())
     except (OSError, ValueError) as exc:
         raise RankingFolderError(f"{folder / 'ranking.json'}: unreadable ({exc})") from exc
+    if not isinstance(record, dict):
+        raise RankingFolderError(f"{folder / 'ranking.json'}: not a ranking record (a JSON object)")
     if record.get("schema") != SCHEMA or record.get("version") != VERSION:
         raise RankingFolderError(f"{folder / 'ranking.json'}: schema {record.get('schema')!r} version "
                                  f"{record.get('version')!r}; this graspdef reads {SCHEMA} version {VERSION}")
-    with open(folder / "ranking.csv", newline="") as fh:
-        rd = csv.reader(fh)
-        header = next(rd, None)
-        if header != COLUMN_NAMES:
-            raise RankingFolderError(f"{folder / 'ranking.csv'}: columns {header} are not those of this graspdef")
-        try:
-            data = np.array([[float(x) for x in r] for r in rd], dtype=float).reshape(-1, len(COLUMN_NAMES))
-        except ValueError as exc:
-            raise RankingFolderError(f"{folder / 'ranking.csv'}: a value is not a number ({exc})") from exc
+    try:
+        with open(folder / "ranking.csv", newline="") as fh:
+            header, *lines = list(csv.reader(fh)) or [None]
+    except (UnicodeDecodeError, csv.Error) as exc:
+        raise RankingFolderError(f"{folder / 'ranking.csv'}: unreadable ({exc})") from None
+    if header != COLUMN_NAMES:
+        raise RankingFolderError(f"{folder / 'ranking.csv'}: columns {header} are not those of this graspdef")
+    short = [k for k, r in enumerate(lines, start=2) if len(r) != len(COLUMN_NAMES)]
+    if short:
+        raise RankingFolderError(f"{folder / 'ranking.csv'}: line {short[0]} has {len(lines[short[0] - 2])} "
+                                 f"values, not {len(COLUMN_NAMES)}")
+    try:
+        data = np.array([[float(x) for x in r] for r in lines], dtype=float).reshape(-1, len(COLUMN_NAMES))
+    except ValueError as exc:
+        raise RankingFolderError(f"{folder / 'ranking.csv'}: a value is not a number ({exc})") from exc
     table = {c: (data[:, i].astype(np.int64) if c in INT_COLUMNS else data[:, i]) for i, c in enumerate(COLUMN_NAMES)}
     verts, faces, attrs, units = _ply(folder / "compliance.ply", str(folder))
-    if units != "m" or attrs is None or "compliance_m_per_N" not in (attrs.dtype.names or ()):
+    maps = ("compliance_m_per_N", "stiffness_N_per_m", "pinch_width_m")
+    if units != "m" or attrs is None or not set(maps) <= set(attrs.dtype.names or ()):
         raise RankingFolderError(f"{folder / 'compliance.ply'}: not a compliance map in metres (units {units!r}, "
-                                 "needs compliance_m_per_N per vertex)")
-    with np.load(folder / "shapes.npz") as z:
-        cands, disp = z["candidates"], z["displacement"]
+                                 f"needs {', '.join(maps)} per vertex)")
+    try:
+        with np.load(folder / "shapes.npz") as z:
+            cands, disp = z["candidates"], z["displacement"]
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
+        raise RankingFolderError(f"{folder / 'shapes.npz'}: unreadable ({exc})") from None
     if disp.ndim != 3 or disp.shape[1:] != verts.shape or len(cands) != len(disp):
         raise RankingFolderError(f"{folder / 'shapes.npz'}: displacement {disp.shape} does not match the surface's "
                                  f"{verts.shape} and {len(cands)} candidates")
+    absent = sorted(set(np.asarray(cands).tolist()) - set(table["candidate"].tolist()))
+    if absent:
+        raise RankingFolderError(f"{folder / 'shapes.npz'}: candidates {absent} are not in ranking.csv")
     return Ranking(folder, record, table, verts, faces,
                    np.asarray(attrs["compliance_m_per_N"], float), np.asarray(attrs["stiffness_N_per_m"], float),
                    np.asarray(attrs["pinch_width_m"], float), np.asarray(cands), disp)

@@ -1,4 +1,5 @@
-"""The browser viewer (issue 7): ``graspdef view RUN_DIR [RUN_DIR ...]`` serves a viser page on
+"""The browser viewer (issue 7): ``graspdef view RUN_DIR [RUN_DIR ...]`` (or a ranking folder:
+:mod:`.ranking`) serves a viser page on
 127.0.0.1.  viser is imported only in :mod:`graspdef.viewer.server`, and only when a viewer
 starts; run folders are read with :func:`graspdef.runs.read_run`; the drawing helpers (:mod:`.layers`) need numpy,
 scipy and trimesh only."""

@@ -109,3 +109,68 @@ def chart_svg(x: np.ndarray, y: np.ndarray, current: int | None, xlabel: str, yl
             f'<text x="10" y="{(mt + height - mb) / 2}" text-anchor="middle" '
             f'transform="rotate(-90 10 {(mt + height - mb) / 2})">{html.escape(ylabel)}</text>', "</svg>"]
     return "".join(out)
+
+
+# ---- ranking folders (graspdef rank) ---------------------------------------------------------------
+#: colour of vertices without a value (NaN: e.g. no pinch fits there), RGB 0..255
+NAN_GREY = (150, 150, 150)
+#: best -> worst rank: green - yellow - red
+RANKS = np.array([[0, 160, 60], [150, 205, 40], [250, 210, 0], [245, 120, 20], [215, 25, 30]], float)
+
+
+def log_colormap(values: np.ndarray, vmin: float, vmax: float, table: np.ndarray = VIRIDIS,
+                 nan: tuple[int, int, int] = NAN_GREY) -> np.ndarray:
+    """RGB colours (n, 3) uint8 of positive ``values`` on a log scale [vmin, vmax] (clipped); NaN
+    and non-positive values get ``nan`` (grey)."""
+    v = np.asarray(values, float)
+    bad = ~(np.isfinite(v) & (v > 0))
+    logs = np.log10(np.where(bad, 1.0, v))
+    out = colormap(logs, float(np.log10(vmin)), float(np.log10(vmax)), table)
+    out[bad] = nan
+    return out
+
+
+def log_ticks(vmin: float, vmax: float) -> list[float]:
+    """Tick values 1, 2, 5 x 10^k inside [vmin, vmax] (positive); the two ends as well when fewer
+    than three such values fall inside."""
+    if not (vmin > 0 and vmax > vmin):
+        return [float(vmin)]
+    ticks = [m * 10.0 ** e for e in range(int(np.floor(np.log10(vmin))), int(np.ceil(np.log10(vmax))) + 1)
+             for m in (1, 2, 5) if vmin * (1 - 1e-9) <= m * 10.0 ** e <= vmax * (1 + 1e-9)]
+    if len(ticks) < 3:
+        ticks = sorted(set([float(vmin), *ticks, float(vmax)]))
+    return [float(t) for t in ticks]
+
+
+def log_legend_html(title: str, unit: str, vmin: float, vmax: float, table: np.ndarray = VIRIDIS,
+                    nan_label: str | None = None) -> str:
+    """A horizontal colour bar on a log scale with ticks, its title and unit, and (``nan_label``)
+    a grey swatch for vertices without a value, as HTML for a GUI panel."""
+    stops = ", ".join(f"rgb({int(r)},{int(g)},{int(b)}) {100 * k / (len(table) - 1):.0f}%"
+                      for k, (r, g, b) in enumerate(table))
+    lo, hi = np.log10(vmin), np.log10(vmax)
+    span = hi - lo if hi > lo else 1.0
+    marks = "".join(
+        f'<span style="position:absolute;left:{100 * (np.log10(t) - lo) / span:.1f}%;transform:translateX(-50%);'
+        f'font-size:10px">{t:.3g}</span>' for t in log_ticks(vmin, vmax))
+    grey = ""
+    if nan_label:
+        r, g, b = NAN_GREY
+        grey = (f'<div style="font-size:11px;margin-top:6px"><span style="display:inline-block;width:12px;'
+                f'height:10px;background:rgb({r},{g},{b});margin-right:4px"></span>{html.escape(nan_label)}</div>')
+    return (f'<div style="padding:4px 12px 8px 12px;font-family:sans-serif">'
+            f'<div style="font-size:12px;margin-bottom:2px">{html.escape(title)} [{html.escape(unit)}], log scale</div>'
+            f'<div style="height:12px;border-radius:2px;background:linear-gradient(to right, {stops})"></div>'
+            f'<div style="position:relative;height:12px">{marks}</div>{grey}</div>')
+
+
+def rank_colours(n: int) -> np.ndarray:
+    """Colours (n, 3) uint8 of ranks 1..n: the best green, the worst red."""
+    if n <= 0:
+        return np.zeros((0, 3), np.uint8)
+    return colormap(np.arange(n, dtype=float), 0.0, float(max(n - 1, 1)), RANKS)
+
+
+def segments(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """Line segments (n, 2, 3) from ``first`` (n, 3) to ``second`` (n, 3)."""
+    return np.stack([np.asarray(first, float), np.asarray(second, float)], axis=1)
