@@ -79,14 +79,17 @@ def grasp_along(mesh: TriMesh, point, axis, where: str = "grasp") -> Grasp:
 
 
 def antipodal_candidates(mesh: TriMesh, centre_of_mass, friction: float, max_width: float, min_width: float,
-                         n: int | None = None, seed: int = 0, limit: int | None = None) -> list[Grasp]:
+                         n: int | None = None, seed: int = 0, limit: int | None = None,
+                         max_reach: float | None = None) -> list[Grasp]:
     """Antipodal grasps of the surface, least cost first: from each start point (every vertex,
     and with ``n`` above the vertex count, ``n`` - vertices seeded random surface points) a ray
     along the inward normal to the surface's far side; a pair qualifies if its chord fits the
     gripper (``min_width`` to ``max_width`` [m]), both ends lie inside the friction cone (angle <
     atan(friction)) and the line crosses the surface only there (the fingers come from outside).
     Cost: the antipodal angle over the cone's, plus the line's distance from the centre of mass
-    (the weight's torque) over half the object's size.  ``limit``: stop after that many."""
+    (the weight's torque) over half the object's size.  ``limit``: stop after that many.
+    ``max_reach`` [m]: also refuse a line along which the object reaches farther than this from
+    the chord's midpoint (the open fingers would cut it; :func:`pose_for`'s check)."""
     tm = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False)
     starts, normals = mesh.vertices, vertex_normals(mesh)
     if n is not None and n > len(starts):
@@ -131,6 +134,10 @@ def antipodal_candidates(mesh: TriMesh, centre_of_mass, friction: float, max_wid
         np.minimum.at(lo, ridx, t)
         np.maximum.at(hi, ridx, t)
         ok = np.isfinite(lo) & (lo >= far - 1e-4 * size) & (hi <= far + w[blk] + 1e-4 * size)
+        if max_reach is not None:
+            centre = 0.5 * (p[blk] + q[blk])
+            reach = np.abs(np.einsum("vk,bk->bv", mesh.vertices, d[blk]) - np.einsum("bk,bk->b", centre, d[blk])[:, None])
+            ok &= reach.max(axis=1) <= max_reach
         for k in np.flatnonzero(ok):
             j = blk[k]
             out.append(Grasp(p[j].copy(), q[j].copy(), d[j].copy(), float(angle[j]), "best antipodal pair (automatic)"))
@@ -141,7 +148,8 @@ def antipodal_candidates(mesh: TriMesh, centre_of_mass, friction: float, max_wid
 
 def best_antipodal(mesh: TriMesh, centre_of_mass, friction: float, max_width: float, min_width: float) -> Grasp:
     """The least-cost antipodal grasp of :func:`antipodal_candidates` (its vertices only)."""
-    found = antipodal_candidates(mesh, centre_of_mass, friction, max_width, min_width, limit=1)
+    found = antipodal_candidates(mesh, centre_of_mass, friction, max_width, min_width, limit=1,
+                                 max_reach=OPEN - CLEARANCE)
     if not found:
         cone = math.degrees(math.atan(friction))
         raise ProblemError(f"no antipodal grasp found: no pair of surface points {min_width * 1e3:.0f} to "

@@ -23,7 +23,7 @@ from ..objects.placement import CLEARANCE, antipodal_candidates
 from ..runs.folder import check_output_folder
 from ..runs.ranking import write_ranking
 from ..sim.gripper import OPEN, TRAVEL, GripperModel
-from .screen import LinearScreen
+from .screen import LinearScreen, PairFigures
 
 #: torsional friction of a fingertip contact [m] (MuJoCo condim 4: torque = this x normal force;
 #: the scenes' 0.005)
@@ -96,15 +96,31 @@ def compliance_map(screen: LinearScreen, max_width: float | None = None, progres
     return {"compliance_m_per_N": comp, "stiffness_N_per_m": stiff, "pinch_width_m": np.where(has, width, np.nan)}
 
 
+def screen_chunk(scene, force: float, first: np.ndarray, second: np.ndarray, pad_size: float) -> PairFigures:
+    """The linear figures of the pairs (``first[j]``, ``second[j]``) [m, contacts on the outer
+    surface] of ``scene``'s object at ``force`` [N] -- a whole screen in one call (its own
+    factorisation): the unit of work a Dask worker runs (graspdef.sweep.rank)."""
+    spec = load_object(scene_xml(scene))
+    shell, _ = build_shell(spec, "linear")
+    screen = LinearScreen(shell, shell.material.E, shell.material.nu, pad_radius=0.5 * pad_size)
+    try:
+        return screen.evaluate(screen.locate(first)[0], screen.locate(second)[0], force)
+    finally:
+        screen.close()
+
+
 def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: int = 10,
                 strain_limit: float | None = None, pad_size: float = GripperModel.pad_size,
-                with_map: bool = True, recheck: int = 0, progress=None) -> dict:
+                with_map: bool = True, recheck: int = 0, progress=None, screen_with=None,
+                extra: dict | None = None) -> dict:
     """Rank up to ``candidates`` antipodal grasps of ``scene``'s object at ``force`` [N] per finger;
     write the ranking folder ``out`` when given; return the record (SI).
 
     ``strain_limit``: the wall's allowed principal strain (e.g. 0.02); ``pad_size`` [m]: the flat
     pad's edge for the contact-area estimate; ``recheck``: re-run the best k fully nonlinear
-    (graspdef.ranking.recheck); ``progress(stage, info)``."""
+    (graspdef.ranking.recheck); ``progress(stage, info)``; ``screen_with(first, second)``: screens
+    the candidates elsewhere (graspdef.sweep.rank: on Dask) and returns their PairFigures; ``extra``:
+    entries added to the record (how it was screened)."""
     say = progress or (lambda stage, info=None: None)
     if not (isinstance(force, (int, float)) and math.isfinite(force) and force > 0):
         raise ProblemError(f"--force must be a positive number of newtons, got {force!r}")
@@ -120,12 +136,17 @@ def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: i
     t0 = time.perf_counter()
     xml = scene_xml(scene)
     spec = load_object(xml)
+    if spec.gas is not None:
+        raise ProblemError(f"{spec.file}: the object encloses a gas ([gas]); the linear screen has no pressurised "
+                           "rest state (its prestress and the gas's volume stiffness), so it would rank a different "
+                           "object: rank it without the gas, or grasp candidates one by one (graspdef grasp)")
     mass, com, friction = scene_facts(xml, spec.body)
     say("candidates")
     outer, _ = outer_surface(spec)
     max_width, min_width = 2 * (OPEN - CLEARANCE), 2 * (OPEN - TRAVEL) + 2 * CLEARANCE
     cands = antipodal_candidates(outer, com, friction, max_width=max_width, min_width=min_width,
-                                 n=int(candidates), seed=0, limit=int(candidates))
+                                 n=int(candidates), seed=0, limit=int(candidates),
+                                 max_reach=OPEN - CLEARANCE)
     if not cands:
         raise ProblemError(f"{spec.file}: no antipodal grasp candidates {min_width * 1e3:.0f} to {max_width * 1e3:.0f} mm "
                            f"wide (the gripper's opening) within the friction cone (friction {friction:g})")
@@ -140,7 +161,10 @@ def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: i
         second = np.array([g.second for g in cands])
         i1, d1 = screen.locate(first)
         i2, d2 = screen.locate(second)
-        fig = screen.evaluate(i1, i2, force, lambda done, of: say("candidate", {"done": done, "of": len(cands)}))
+        if screen_with is None:
+            fig = screen.evaluate(i1, i2, force, lambda done, of: say("candidate", {"done": done, "of": len(cands)}))
+        else:
+            fig = screen_with(first, second)
         t_screen = time.perf_counter()
         rows = _rows(cands, fig, force, friction, mass, com, strain_limit)
         order = [r["candidate"] for r in rows]
@@ -184,6 +208,7 @@ def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: i
         "candidates_per_minute": 60.0 * len(rows) / max(t_screen - t_factor, 1e-9),
         "top": rows[: int(top)],
     }
+    record.update(extra or {})
     if recheck:
         from .recheck import recheck_top
 
