@@ -211,6 +211,22 @@ def _case(name: str, tmp: Path) -> tuple[list[str], str]:
                                              "--out", out], "beyond what the actuators"),
         "sweep: unreachable scheduler": lambda: (["sweep", _file(tmp, "s.toml", SPEC), "--out", out, "--scheduler",
                                           "tcp://127.0.0.1:9"], "127.0.0.1:9"),
+        # --- rank
+        "rank: negative force": lambda: (["rank", "test_sphere", "--force", "-3", "--out", out], "--force must be"),
+        "rank: force that is not a number": lambda: (["rank", "test_sphere", "--force", "lots", "--out", out],
+                                                     "not a number with a unit"),
+        "rank: no candidates": lambda: (["rank", "test_sphere", "--force", "5", "--candidates", "0", "--out", out],
+                                        "--candidates must be"),
+        "rank: strain limit above 100 %": lambda: (["rank", "test_sphere", "--force", "5", "--strain-limit", "150%",
+                                                    "--out", out], "--strain-limit must be"),
+        "rank: pad size beyond the gripper's": lambda: (["rank", "test_sphere", "--force", "5", "--pad-size", "1m",
+                                                         "--out", out], "pad size must be"),
+        "rank: --chunks without Dask": lambda: (["rank", "test_sphere", "--force", "5", "--chunks", "4", "--out", out],
+                                                "--chunks needs"),
+        "rank: an object with a gas": lambda: (["rank", "tennis_ball", "--force", "5", "--out", out], "encloses a gas"),
+        "rank: unknown object": lambda: (["rank", "no_such_scene", "--force", "5", "--out", out], "scene not found"),
+        "rank: --out holds other files": lambda: (["rank", "test_sphere", "--force", "5", "--out", str(tmp / "photos")],
+                                                  "not a graspdef run folder"),
         # --- bench
         "bench: missing folder": lambda: (["bench", "linear", "--dir", str(tmp / "nowhere")], "nowhere"),
     }
@@ -232,7 +248,10 @@ NAMES = sorted([
     "object add: no mass or density", "object add: thickness outside the thin-shell range",
     "object add: E in the wrong unit", "object add: grasp axis without a point",
     "object add: grasp wider than the gripper", "object add: too many faces", "object add: --out not empty",
-    "solve: mesh too large for the memory", "solve: unbalanced loads on a free body"])
+    "solve: mesh too large for the memory", "solve: unbalanced loads on a free body", "rank: negative force",
+    "rank: force that is not a number", "rank: no candidates", "rank: strain limit above 100 %",
+    "rank: pad size beyond the gripper's", "rank: --chunks without Dask", "rank: an object with a gas",
+    "rank: unknown object", "rank: --out holds other files"])
 
 
 def test_the_matrix_has_at_least_30_classes():

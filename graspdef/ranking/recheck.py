@@ -1,8 +1,10 @@
 """The nonlinear re-evaluation of the best candidates of a linear screen: each one grasped by the
-whole chain (graspdef.pipeline: MuJoCo's pad gripper with friction settles the grasp, the fingertip
-pads become rigid obstacles pushed with the force -- geometric contact -- and MuJoCo's friction
-forces stay as dead loads; the object's own nonlinear law), with the object placed for that
-candidate's grasp line (graspdef.objects.placement.pose_for).
+whole chain (graspdef.pipeline: MuJoCo's pad gripper with friction settles the grasp; its contact
+forces -- normal and friction, spread over the pads' contact points -- are mapped onto the shell
+as loads, the paper's model; the object's own nonlinear law), with the object placed for that
+candidate's grasp line (graspdef.objects.placement.pose_for).  (Geometric contact, the pads as
+rigid obstacles, refuses a start where MuJoCo's soft pad sits inside the shell's outer surface,
+which the settled pads of a stiff object often do.)
 
 Each candidate runs in a copy of the object's folder whose pad scene has the object's pose
 replaced (the gripper file is included by its absolute path).  A candidate the gripper cannot
@@ -70,7 +72,7 @@ def recheck_top(scene, spec, rows: list[dict], force: float, progress=None) -> d
             t0 = time.perf_counter()
             try:
                 xml = posed_scene(scene, spec.body, g, outer, Path(tmp) / f"candidate_{r['candidate']}")
-                run = run_grasp(xml, force, contact="geometric", analysis="nonlinear")
+                run = run_grasp(xml, force, contact="point", analysis="nonlinear")
                 fb = run.result.get("feedback", {})
                 approach = fb.get("approach_m")
                 entry.update({"status": "ok", "nonlinear_closing_m": approach,
@@ -85,7 +87,8 @@ def recheck_top(scene, spec, rows: list[dict], force: float, progress=None) -> d
     rho = (float(spearmanr([e["linear_closing_m"] for e in ok], [e["nonlinear_closing_m"] for e in ok]).statistic)
            if len(ok) >= 3 else math.nan)
     return {"recheck": out, "recheck_spearman": rho,
-            "recheck_method": "graspdef grasp with the pad gripper, geometric contact, nonlinear, the object's law; "
+            "recheck_method": "graspdef grasp with the pad gripper (MuJoCo, friction), its contact forces as loads, "
+                              "nonlinear, the object's law; "
                               "Spearman rank correlation of the linear and nonlinear closing over the candidates "
                               "that ran (NaN below 3)"}
 

@@ -140,6 +140,9 @@ def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: i
         raise ProblemError(f"{spec.file}: the object encloses a gas ([gas]); the linear screen has no pressurised "
                            "rest state (its prestress and the gas's volume stiffness), so it would rank a different "
                            "object: rank it without the gas, or grasp candidates one by one (graspdef grasp)")
+    if recheck and spec.material.law == "linear":
+        raise ProblemError(f"{spec.file}: --recheck grasps nonlinearly, and [material] law = 'linear' has no "
+                           "finite-strain form: give the object law = 'svk' or a hyperelastic law")
     mass, com, friction = scene_facts(xml, spec.body)
     say("candidates")
     outer, _ = outer_surface(spec)
