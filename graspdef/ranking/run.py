@@ -206,6 +206,10 @@ def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: i
         "rigid_ranking": "rest friction margin (largest first), then the weight's torque ratio (smallest first)",
         "rank_correlation": {"rigid_vs_deformable_spearman": float(rho)},
         "n_held": int(sum(r["held"] for r in rows)), "n_pareto": int(sum(r["pareto"] for r in rows)),
+        "n_beyond_linear_range": int(sum(r["indentation_per_finger_m"] > spec.thickness for r in rows)),
+        "linear_range": ("the screen is linear: a candidate whose indentation per finger exceeds the wall's thickness "
+                         "is outside its range (its figures, the deformed normals most, are indicative only; "
+                         "--recheck runs the best nonlinearly)"),
         "timings_s": {"candidates": t_cand - t0, "factor_and_setup": t_factor - t_cand, "screen": t_screen - t_factor,
                       "map": t_map - t_screen, "total": t_map - t0},
         "candidates_per_minute": 60.0 * len(rows) / max(t_screen - t_factor, 1e-9),
