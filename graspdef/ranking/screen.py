@@ -162,24 +162,29 @@ class LinearScreen:
         """Boundary of each contact's patch -- the sample faces with every corner within
         ``radius`` of sample ``idx[c]`` -- as directed edges (owner c, i, j) oriented with the faces.
         The patch's vector area is 1/2 sum x_i x x_j over them (Stokes): its mean normal."""
-        f, vf = self.samples.faces, self.samples.vertex_faces
+        f, vf, ns = self.samples.faces, self.samples.vertex_faces, self.samples.n
         near = self.tree.query_ball_point(self.P[idx], r=radius)
-        owner, ei, ej = [], [], []
-        inside = np.zeros(self.samples.n, bool)
-        for c, nb in enumerate(near):
-            nb = np.asarray(nb, dtype=np.int64)
-            inside[nb] = True
-            cand = np.unique(vf[nb].indices)
-            fc = f[cand[inside[f[cand]].all(axis=1)]]
-            inside[nb] = False
-            e = np.concatenate([fc[:, [0, 1]], fc[:, [1, 2]], fc[:, [2, 0]]])
-            key = e[:, 0] * self.samples.n + e[:, 1]
-            rev = e[:, 1] * self.samples.n + e[:, 0]
-            b = e[~np.isin(key, rev)]
-            owner.append(np.full(len(b), c))
-            ei.append(b[:, 0])
-            ej.append(b[:, 1])
-        return np.concatenate(owner), np.concatenate(ei), np.concatenate(ej)
+        sizes = np.fromiter((len(x) for x in near), dtype=np.int64, count=len(near))
+        owner = np.repeat(np.arange(len(near)), sizes)
+        inside = np.concatenate([np.asarray(x, dtype=np.int64) for x in near])
+        # (owner, face) for every inside corner; a face is inside when all three corners are
+        sub = vf[inside]                                    # rows in order: the corners' incident faces
+        of = np.repeat(owner, np.diff(sub.indptr))
+        ff = sub.indices.astype(np.int64)
+        key = np.sort(of * len(f) + ff)                     # sort-based counting (numpy's hashed
+        start = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])   # unique is slow on these keys)
+        count = np.diff(np.r_[start, len(key)])
+        full = key[start[count == 3]]
+        fo, fi = full // len(f), full % len(f)
+        fc = f[fi]
+        e = np.concatenate([fc[:, [0, 1]], fc[:, [1, 2]], fc[:, [2, 0]]])
+        eo = np.tile(fo, 3)
+        fwd = (eo * ns + e[:, 0]) * ns + e[:, 1]
+        rev = (eo * ns + e[:, 1]) * ns + e[:, 0]
+        rev.sort()
+        pos = np.minimum(np.searchsorted(rev, fwd), max(len(rev) - 1, 0))
+        b = (rev[pos] != fwd) if len(rev) else np.ones(len(fwd), bool)
+        return eo[b], e[b, 0], e[b, 1]
 
     def _deformed_angles(self, i1, i2, U, radius) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(largest angle [deg] between a deformed inward normal and the deformed line, the same
@@ -196,12 +201,13 @@ class LinearScreen:
         ends = [self._moved(idx, cand, U3) for idx in (i1, i2)]
         umag = np.stack([np.linalg.norm(e - self.P[idx], axis=1) for e, idx in zip(ends, (i1, i2))], 1)
         angles = []
+        rims = {id(i1): self._patch_boundary(i1, radius), id(i2): self._patch_boundary(i2, radius)}
         for field, (p1, p2) in ((U3, ends), (None, (self.P[i1], self.P[i2]))):
             dd = p2 - p1
             dd /= np.linalg.norm(dd, axis=1, keepdims=True)
             ang = np.zeros(k)
             for idx, inward in ((i1, dd), (i2, -dd)):
-                owner, bi, bj = self._patch_boundary(idx, radius)
+                owner, bi, bj = rims[id(idx)]
                 xi = self._moved(bi, owner, field)
                 xj = self._moved(bj, owner, field)
                 n = np.zeros((k, 3))

@@ -46,7 +46,7 @@ def tutorial(tmp_path_factory):
             if argv[0] == "python":
                 subprocess.run([sys.executable, *argv[1:]], check=True, cwd=folder)
             elif argv[:2] == ["graspdef", "view"]:
-                outputs["view"] = argv[2:]
+                outputs.setdefault("view", []).append(argv[2:])
             else:
                 assert argv[0] == "graspdef", line
                 assert main(["-q", *argv[1:]]) == 0, line
@@ -111,6 +111,25 @@ def test_tutorial_report_and_viewer(tutorial):
     run = folder / "runs" / "mustard_50N"
     html = (run / "report.html").read_text()
     assert "mustard" in html and "max. displacement" in html
-    assert outputs["view"] == ["runs/mustard_50N"]
-    with Viewer([folder / outputs["view"][0]], port=0) as v:
+    assert outputs["view"][0] == ["runs/mustard_50N"]
+    with Viewer([folder / outputs["view"][0][0]], port=0) as v:
         assert v.wait_ready(120)
+
+
+def test_tutorial_rank(tutorial):
+    """``graspdef rank`` in the tutorial's object folder: a ranking folder with held candidates,
+    its report (with the Pareto front) and the viewer's ranking page."""
+    from graspdef.runs.ranking import read_ranking
+    from graspdef.viewer.ranking import RankingViewer
+
+    folder, outputs = tutorial
+    r = read_ranking(folder / "runs" / "mustard_rank")
+    assert r.record["force_N"] == 20.0 and r.n >= 500 and r.record["n_held"] > 0
+    assert r.table["held"][0] == 1
+    assert "Pareto" in (folder / "runs" / "mustard_rank" / "report.html").read_text()
+    assert outputs["view"][1] == ["runs/mustard_rank"]
+    v = RankingViewer(folder / outputs["view"][1][0], port=0)
+    try:
+        assert v.n_drawn == min(200, r.n)
+    finally:
+        v.stop()
