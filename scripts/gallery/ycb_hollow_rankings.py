@@ -44,19 +44,20 @@ OBJECTS = [
 def main(argv=None) -> dict:
     a = parse(NAME, __doc__, argv, lambda ap: ap.add_argument(
         "--only", default=None, help="one object key (mustard, bleach, soup_can)"))
+    from graspdef import runtime
+
+    runtime.configure()
     import matplotlib.pyplot as plt
     import numpy as np
     import trimesh
 
-    from graspdef import runtime
     from graspdef.objects.add import add_object
     from graspdef.objects.data import MaterialSpec
     from graspdef.ranking import rank_object
     from graspdef.report import build_report
     from graspdef.runs.ranking import read_ranking
 
-    runtime.configure()
-    faces, n = (1000, 300) if a.fast else (2000, 2000)
+    faces, n = (2000, 300) if a.fast else (2000, 2000)
     todo = [o for o in OBJECTS if a.only in (None, o[0])]
     rows, key = [], {}
     fig, axes = plt.subplots(2, len(todo), figsize=(4.2 * len(todo), 7.5), squeeze=False)
