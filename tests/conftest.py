@@ -112,7 +112,7 @@ def write_synthetic_ranking(out, n_candidates: int = FIXTURE_N_CANDIDATES, n_sha
         "ranking": "held candidates first, then least work (fixture)",
         "timings_s": {"candidates": 0.5, "factor": 1.0, "screen": 2.0, "total": 3.5},
         "candidates_per_minute": 60.0 * len(rows) / 2.0,
-        "rank_correlation": {"rigid_vs_deformable": _spearman(order, [r["rigid_rank"] for r in rows])},
+        "rank_correlation": {"rigid_vs_deformable_spearman": _spearman(order, [r["rigid_rank"] for r in rows])},
     }
     if recheck:
         rc = [{"rank": r["rank"], "candidate": r["candidate"], "linear_closing_m": r["closing_m"],

@@ -220,7 +220,7 @@ def build_ranking_report(folder: str | PathLike, out: str | PathLike | None = No
                    caption=f"Every candidate (grey), the held ones coloured ({int(np.sum(t['held'] == 1))}), and the "
                            f"{int(np.sum(t['pareto'] == 1))} rows flagged pareto = 1 in ranking.csv joined as the "
                            "front (least work, largest deformed friction margin).")]
-    rho = (rec.get("rank_correlation") or {}).get("rigid_vs_deformable")
+    rho = (rec.get("rank_correlation") or {}).get("rigid_vs_deformable_spearman")
     rho_text = (f"Spearman rank correlation rigid vs deformable (ranking.json): ρ = {H.fmt(rho, 3)}."
                 if rho is not None else "ranking.json records no rigid-vs-deformable rank correlation.")
     body += ["<h2 id=\"rigid\">Rigid baseline against the ranking</h2>",

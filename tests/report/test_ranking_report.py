@@ -50,7 +50,7 @@ def test_every_section_and_figure(ranking_report, synthetic_ranking):
     assert [(int(a), int(b)) for a, b in rows] == list(zip(range(1, 11), r.table["candidate"][:10].tolist()))
     assert f"<td>{r.table['work_J'][0] * 1e3:.4g}</td>" in top
     # the rigid-vs-deformable correlation and the recheck's, from the record
-    assert f"ρ = {rec['rank_correlation']['rigid_vs_deformable']:.3g}" in _section(text, "rigid")
+    assert f"ρ = {rec['rank_correlation']['rigid_vs_deformable_spearman']:.3g}" in _section(text, "rigid")
     recheck = _section(text, "recheck")
     assert "nonlinear closing [mm]" in recheck and f"<b>{rec['recheck_spearman']:.3g}</b>" in recheck
     assert recheck.count("<tr>") == 1 + len(rec["recheck"])
