@@ -72,7 +72,7 @@ def write_synthetic_ranking(out, n_candidates: int = FIXTURE_N_CANDIDATES, n_sha
         rows.append({
             "candidate": c, "first_x_m": p1[0], "first_y_m": p1[1], "first_z_m": p1[2],
             "second_x_m": p2[0], "second_y_m": p2[1], "second_z_m": p2[2], "width_m": w,
-            "antipodal_angle_deg": ang, "friction_margin_deg": phi - ang, "closing_m": closing,
+            "antipodal_angle_deg": ang, "friction_margin_deg": phi - ang, "force_N": F, "closing_m": closing,
             "indentation_per_finger_m": h, "work_J": work, "strain_energy_J": work, "grasp_stiffness_N_per_m": k,
             "max_displacement_m": 0.6 * closing, "peak_strain": 2.0 * h / R, "peak_von_mises_Pa": E * 2.0 * h / R,
             "strain_limit_ratio": float("nan"), "contact_area_m2": math.pi * (2 * R * h - h * h),

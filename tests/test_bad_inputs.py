@@ -225,6 +225,12 @@ def _case(name: str, tmp: Path) -> tuple[list[str], str]:
                                                 "--chunks needs"),
         "rank: an object with a gas": lambda: (["rank", "tennis_ball", "--force", "5", "--out", out], "encloses a gas"),
         "rank: unknown object": lambda: (["rank", "no_such_scene", "--force", "5", "--out", out], "scene not found"),
+        "rank: force range reversed": lambda: (["rank", "test_sphere", "--force-range", "10N", "2N", "--out", out],
+                                               "0 < A < B"),
+        "rank: force and force range": lambda: (["rank", "test_sphere", "--force", "5", "--force-range", "1", "2",
+                                                 "--out", out], "one of them"),
+        "rank: force beyond the gripper": lambda: (["rank", "soda_can", "--force", "400", "--out", out],
+                                                   "beyond what the gripper"),
         "rank: --out holds other files": lambda: (["rank", "test_sphere", "--force", "5", "--out", str(tmp / "photos")],
                                                   "not a graspdef run folder"),
         # --- bench
@@ -251,7 +257,8 @@ NAMES = sorted([
     "solve: mesh too large for the memory", "solve: unbalanced loads on a free body", "rank: negative force",
     "rank: force that is not a number", "rank: no candidates", "rank: strain limit above 100 %",
     "rank: pad size beyond the gripper's", "rank: --chunks without Dask", "rank: an object with a gas",
-    "rank: unknown object", "rank: --out holds other files"])
+    "rank: unknown object", "rank: --out holds other files", "rank: force range reversed",
+    "rank: force and force range", "rank: force beyond the gripper"])
 
 
 def test_the_matrix_has_at_least_30_classes():

@@ -16,7 +16,11 @@ DESCRIPTION = ("Sample antipodal grasp candidates on the object's surface (withi
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("scene", help="an object folder (graspdef object add), a scene.xml, or a name under scenes/")
-    ap.add_argument("--force", required=True, help="squeezing force per finger, e.g. 20 or 20N")
+    how_hard = ap        # --force or --force-range: checked by rank_object (one line, exit 2)
+    how_hard.add_argument("--force", help="squeezing force per finger, e.g. 20 or 20N")
+    how_hard.add_argument("--force-range", nargs=2, metavar=("A", "B"), help="a range of forces per finger, e.g. "
+                          "2N 40N: each candidate at the least force in it that holds the object against its "
+                          "weight (slip and twist), ranked by the work at that force")
     ap.add_argument("--candidates", type=int, default=2000, help="how many candidates to screen (2000)")
     ap.add_argument("--strain-limit", default=None, help="the wall's allowed principal strain, e.g. 2%% or 0.02 "
                     "(default: none; the peak strain is reported)")
@@ -51,7 +55,9 @@ def run(a: argparse.Namespace) -> int:
     from ..ranking import rank_object
     from ..units import quantity
 
-    force = quantity(a.force, "force", implied="N", what="--force")
+    force = None if a.force is None else quantity(a.force, "force", implied="N", what="--force")
+    force_range = None if a.force_range is None else tuple(
+        quantity(x, "force", implied="N", what="--force-range") for x in a.force_range)
     pad = quantity(a.pad_size, "length", what="--pad-size")
 
     def say(stage, info=None):
@@ -65,7 +71,7 @@ def run(a: argparse.Namespace) -> int:
                          "map": "the compliance map", "recheck": "nonlinear recheck of the best candidates"
                          }.get(stage, stage))
 
-    kw = dict(top=a.top, strain_limit=_fraction(a.strain_limit), pad_size=pad, with_map=a.with_map,
+    kw = dict(force_range=force_range, top=a.top, strain_limit=_fraction(a.strain_limit), pad_size=pad, with_map=a.with_map,
               recheck=a.recheck, progress=say)
     if a.workers is not None or a.scheduler is not None:
         from ..sweep.rank import rank_on_dask
@@ -78,14 +84,16 @@ def run(a: argparse.Namespace) -> int:
 
             raise ProblemError("--chunks needs --workers or --scheduler (the Dask screen)")
         r = rank_object(a.scene, force, a.candidates, a.out, **kw)
-    print(f"{r['object']}: {r['n_candidates']} candidates at {r['force_N']:g} N per finger, friction {r['friction']:g}; "
+    at = (f"{r['force_N']:g} N" if not r.get("force_range_N") else
+          f"{r['force_range_N'][0]:g}-{r['force_range_N'][1]:g} N (each at its least holding force)")
+    print(f"{r['object']}: {r['n_candidates']} candidates at {at} per finger, friction {r['friction']:g}; "
           f"screened {r['candidates_per_minute']:.0f} per minute ({r['control_vertices']} control vertices); "
           f"{r['n_held']} hold; rigid vs deformable rank correlation "
           f"{r['rank_correlation']['rigid_vs_deformable_spearman']:.2f}")
-    print(f"{'rank':>4} {'width mm':>8} {'indent mm':>9} {'work mJ':>8} {'k N/mm':>7} {'strain %':>8} "
+    print(f"{'rank':>4} {'width mm':>8} {'force N':>7} {'indent mm':>9} {'work mJ':>8} {'k N/mm':>7} {'strain %':>8} "
           f"{'margin deg':>10} {'rigid':>5} {'held':>4}")
     for row in r["top"]:
-        print(f"{row['rank']:4d} {row['width_m'] * 1e3:8.1f} {row['indentation_per_finger_m'] * 1e3:9.3f} "
+        print(f"{row['rank']:4d} {row['width_m'] * 1e3:8.1f} {row['force_N']:7.2f} {row['indentation_per_finger_m'] * 1e3:9.3f} "
               f"{row['work_J'] * 1e3:8.3f} {row['grasp_stiffness_N_per_m'] * 1e-3:7.2f} {row['peak_strain'] * 100:8.2f} "
               f"{row['deformed_friction_margin_deg']:10.1f} {row['rigid_rank']:5d} {'yes' if row['held'] else 'no':>4}")
     if r.get("recheck"):

@@ -53,8 +53,9 @@ def posed_scene(scene, body: str, grasp: Grasp, outer, folder: Path) -> Path:
     return out
 
 
-def recheck_top(scene, spec, rows: list[dict], force: float, progress=None) -> dict:
-    """Grasp each candidate of ``rows`` (the ranking's best, in rank order) nonlinearly; return
+def recheck_top(scene, spec, rows: list[dict], progress=None) -> dict:
+    """Grasp each candidate of ``rows`` (the ranking's best, in rank order) nonlinearly at its
+    force (column force_N); return
     ``{"recheck": [...], "recheck_spearman": rho}`` -- rho between the linear and the nonlinear
     approach of the fingers over the candidates that ran."""
     say = progress or (lambda stage, info=None: None)
@@ -72,7 +73,7 @@ def recheck_top(scene, spec, rows: list[dict], force: float, progress=None) -> d
             t0 = time.perf_counter()
             try:
                 xml = posed_scene(scene, spec.body, g, outer, Path(tmp) / f"candidate_{r['candidate']}")
-                run = run_grasp(xml, force, contact="point", analysis="nonlinear")
+                run = run_grasp(xml, r["force_N"], contact="point", analysis="nonlinear")
                 fb = run.result.get("feedback", {})
                 approach = fb.get("approach_m")
                 entry.update({"status": "ok", "nonlinear_closing_m": approach,

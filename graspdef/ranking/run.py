@@ -20,6 +20,7 @@ from ..errors import ProblemError
 from ..objects import build_shell, load_object, scene_xml
 from ..objects.build import outer_surface
 from ..objects.placement import CLEARANCE, antipodal_candidates
+from ..pipeline.grasp import check_force
 from ..runs.folder import check_output_folder
 from ..runs.ranking import write_ranking
 from ..sim.gripper import OPEN, TRAVEL, GripperModel
@@ -96,9 +97,9 @@ def compliance_map(screen: LinearScreen, max_width: float | None = None, progres
     return {"compliance_m_per_N": comp, "stiffness_N_per_m": stiff, "pinch_width_m": np.where(has, width, np.nan)}
 
 
-def screen_chunk(scene, force: float, first: np.ndarray, second: np.ndarray, pad_size: float) -> PairFigures:
+def screen_chunk(scene, force, first: np.ndarray, second: np.ndarray, pad_size: float) -> PairFigures:
     """The linear figures of the pairs (``first[j]``, ``second[j]``) [m, contacts on the outer
-    surface] of ``scene``'s object at ``force`` [N] -- a whole screen in one call (its own
+    surface] of ``scene``'s object at ``force`` [N, one or one per pair] -- a whole screen in one call (its own
     factorisation): the unit of work a Dask worker runs (graspdef.sweep.rank)."""
     spec = load_object(scene_xml(scene))
     shell, _ = build_shell(spec, "linear")
@@ -109,19 +110,37 @@ def screen_chunk(scene, force: float, first: np.ndarray, second: np.ndarray, pad
         screen.close()
 
 
-def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: int = 10,
+def holding_force(mass: float, friction: float, off: np.ndarray) -> np.ndarray:
+    """The least squeezing force per finger [N] at which the weight neither slips the grasp
+    (m g <= 2 friction F) nor twists it about the grasp line (m g off <= 2 TORSIONAL_FRICTION F),
+    per candidate of line distance ``off`` [m] from the centre of mass (gravity across the line)."""
+    return np.maximum(mass * G / (2.0 * friction), mass * G * np.asarray(off) / (2.0 * TORSIONAL_FRICTION))
+
+
+def rank_object(scene, force: float | None = None, candidates: int = 2000, out=None, *, top: int = 10,
+                force_range: tuple[float, float] | None = None,
                 strain_limit: float | None = None, pad_size: float = GripperModel.pad_size,
                 with_map: bool = True, recheck: int = 0, progress=None, screen_with=None,
                 extra: dict | None = None) -> dict:
-    """Rank up to ``candidates`` antipodal grasps of ``scene``'s object at ``force`` [N] per finger;
-    write the ranking folder ``out`` when given; return the record (SI).
+    """Rank up to ``candidates`` antipodal grasps of ``scene``'s object at ``force`` [N] per finger,
+    or, with ``force_range`` (A, B) [N], each at the least force in [A, B] that holds it against its
+    weight (:func:`holding_force`; B when none does) -- how hard to grasp, and where; write the
+    ranking folder ``out`` when given; return the record (SI).
 
     ``strain_limit``: the wall's allowed principal strain (e.g. 0.02); ``pad_size`` [m]: the flat
     pad's edge for the contact-area estimate; ``recheck``: re-run the best k fully nonlinear
     (graspdef.ranking.recheck); ``progress(stage, info)``; ``screen_with(first, second)``: screens
-    the candidates elsewhere (graspdef.sweep.rank: on Dask) and returns their PairFigures; ``extra``:
+    the candidates elsewhere (graspdef.sweep.rank: on Dask) at their forces (``screen_with(first,
+    second, forces)``) and returns their PairFigures; ``extra``:
     entries added to the record (how it was screened)."""
     say = progress or (lambda stage, info=None: None)
+    if (force is None) == (force_range is None):
+        raise ProblemError("give --force F or --force-range A B, one of them")
+    if force_range is not None:
+        lo, hi = (float(x) for x in force_range)
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+            raise ProblemError(f"--force-range must be two forces 0 < A < B in newtons, got {force_range!r}")
+        force = hi
     if not (isinstance(force, (int, float)) and math.isfinite(force) and force > 0):
         raise ProblemError(f"--force must be a positive number of newtons, got {force!r}")
     if not 1 <= int(candidates) <= 100_000:
@@ -136,6 +155,7 @@ def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: i
     t0 = time.perf_counter()
     xml = scene_xml(scene)
     spec = load_object(xml)
+    check_force(xml, float(force))                   # the gripper's force range
     if spec.gas is not None:
         raise ProblemError(f"{spec.file}: the object encloses a gas ([gas]); the linear screen has no pressurised "
                            "rest state (its prestress and the gas's volume stiffness), so it would rank a different "
@@ -164,15 +184,21 @@ def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: i
         second = np.array([g.second for g in cands])
         i1, d1 = screen.locate(first)
         i2, d2 = screen.locate(second)
-        if screen_with is None:
-            fig = screen.evaluate(i1, i2, force, lambda done, of: say("candidate", {"done": done, "of": len(cands)}))
+        if force_range is None:
+            forces = np.full(len(cands), float(force))
         else:
-            fig = screen_with(first, second)
+            axis = np.array([g.axis for g in cands])
+            off = np.linalg.norm(np.cross(com - first, axis), axis=1)
+            forces = np.clip(holding_force(mass, friction, off), lo, hi)
+        if screen_with is None:
+            fig = screen.evaluate(i1, i2, forces, lambda done, of: say("candidate", {"done": done, "of": len(cands)}))
+        else:
+            fig = screen_with(first, second, forces)
         t_screen = time.perf_counter()
-        rows = _rows(cands, fig, force, friction, mass, com, strain_limit)
+        rows = _rows(cands, fig, forces, friction, mass, com, strain_limit)
         order = [r["candidate"] for r in rows]
         best = np.array(order[: min(SHAPES, len(order))])
-        U, _, _ = screen.solve(i1[best], i2[best], force)
+        U, _, _ = screen.solve(i1[best], i2[best], forces[best])
         shapes = screen.surface_displacements(U)
         maps = {"compliance_m_per_N": np.full(screen.n_control, np.nan), "stiffness_N_per_m":
                 np.full(screen.n_control, np.nan), "pinch_width_m": np.full(screen.n_control, np.nan)}
@@ -191,7 +217,13 @@ def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: i
     record = {
         "units": {"length": "m", "force": "N", "energy": "J", "stiffness": "N/m", "angle": "deg", "stress": "Pa",
                   "area": "m^2"},
-        "object": spec.body, "scene": str(xml), "force_N": float(force), "friction": friction, "mass_kg": mass,
+        "object": spec.body, "scene": str(xml), "force_N": float(force),
+        "force_range_N": None if force_range is None else [lo, hi],
+        "force_rule": ("one force for every candidate" if force_range is None else
+                       "each candidate at the least force in the range that holds it against its weight "
+                       "(slip: m g / (2 friction); twist: m g off / (2 torsional friction)); the range's top "
+                       "when none does"),
+        "friction": friction, "mass_kg": mass,
         "centre_of_mass_m": com.tolist(), "gravity_m_per_s2": G, "torsional_friction_m": TORSIONAL_FRICTION,
         "material": {"model": "linear_elastic (the object's small-strain moduli)", "E_Pa": E, "nu": nu,
                      "law": spec.material.law, "source": spec.material.source},
@@ -220,14 +252,14 @@ def rank_object(scene, force: float, candidates: int = 2000, out=None, *, top: i
         from .recheck import recheck_top
 
         say("recheck")
-        record.update(recheck_top(scene, spec, rows[: int(recheck)], force, progress=say))
+        record.update(recheck_top(scene, spec, rows[: int(recheck)], progress=say))
     if out is not None:
         write_ranking(out, record, rows, rest, faces, maps, best, shapes)
         record["out"] = str(out)
     return record
 
 
-def _rows(cands, fig, force, friction, mass, com, strain_limit) -> list[dict]:
+def _rows(cands, fig, force: np.ndarray, friction, mass, com, strain_limit) -> list[dict]:
     """The table's rows in rank order (every column of graspdef.runs.ranking.COLUMNS)."""
     cone = math.degrees(math.atan(friction))
     n = len(cands)
@@ -241,7 +273,9 @@ def _rows(cands, fig, force, friction, mass, com, strain_limit) -> list[dict]:
     slip = mass * G / (2.0 * friction * force)
     dmargin = cone - fig.deformed_angle_deg
     ratio = fig.peak_strain / strain_limit if strain_limit else np.full(n, np.nan)
-    held = (dmargin > 0) & (torque < 1.0) & (slip < 1.0) & (~(ratio > 1.0))
+    # at most 1 (not below): with a force range a candidate sits exactly at its least holding force
+    eps = 1e-9
+    held = (dmargin > 0) & (torque <= 1.0 + eps) & (slip <= 1.0 + eps) & (~(ratio > 1.0))
     rank_order = np.lexsort((np.arange(n), fig.work_J, ~held))
     rigid_order = np.lexsort((np.arange(n), torque, -margin))
     rank = np.empty(n, np.int64)
@@ -256,7 +290,7 @@ def _rows(cands, fig, force, friction, mass, com, strain_limit) -> list[dict]:
             "first_x_m": first[i, 0], "first_y_m": first[i, 1], "first_z_m": first[i, 2],
             "second_x_m": second[i, 0], "second_y_m": second[i, 1], "second_z_m": second[i, 2],
             "width_m": float(np.linalg.norm(second[i] - first[i])), "antipodal_angle_deg": float(angle[i]),
-            "friction_margin_deg": float(margin[i]), "rigid_rank": int(rigid[i]),
+            "friction_margin_deg": float(margin[i]), "rigid_rank": int(rigid[i]), "force_N": float(force[i]),
             "closing_m": float(fig.closing_m[i]), "indentation_per_finger_m": 0.5 * float(fig.closing_m[i]),
             "work_J": float(fig.work_J[i]), "strain_energy_J": float(fig.strain_energy_J[i]),
             "grasp_stiffness_N_per_m": float(fig.stiffness_N_per_m[i]),
@@ -264,6 +298,6 @@ def _rows(cands, fig, force, friction, mass, com, strain_limit) -> list[dict]:
             "peak_von_mises_Pa": float(fig.peak_von_mises_Pa[i]), "strain_limit_ratio": float(ratio[i]),
             "contact_area_m2": float(fig.contact_area_m2[i]),
             "deformed_friction_margin_deg": float(dmargin[i]), "weight_torque_ratio": float(torque[i]),
-            "weight_slip_ratio": float(slip), "held": int(held[i]), "pareto": int(pareto[i]),
+            "weight_slip_ratio": float(slip[i]), "held": int(held[i]), "pareto": int(pareto[i]),
         })
     return rows

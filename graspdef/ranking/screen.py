@@ -138,10 +138,11 @@ class LinearScreen:
                           shape=(self.shell.n_dofs, len(i1)))
         return B, d
 
-    def solve(self, i1, i2, force: float) -> tuple[np.ndarray, sp.csc_matrix, np.ndarray]:
-        """Displacements U (3 n_control, k) [m] of the pairs at ``force`` [N], with B and d."""
+    def solve(self, i1, i2, force) -> tuple[np.ndarray, sp.csc_matrix, np.ndarray]:
+        """Displacements U (3 n_control, k) [m] of the pairs at ``force`` [N] (one, or one per
+        pair), with B and d."""
         B, d = self.unit_pairs(np.asarray(i1), np.asarray(i2))
-        U, _, _ = self.kkt.solve(force * B.toarray())
+        U, _, _ = self.kkt.solve(B.toarray() * np.broadcast_to(np.asarray(force, float), (len(d),))[None, :])
         return U, B, d
 
     def surface_displacements(self, U: np.ndarray) -> np.ndarray:
@@ -237,13 +238,16 @@ class LinearScreen:
             out[j] = float(self.area[nb[sel]].sum())
         return out
 
-    def evaluate(self, i1, i2, force: float, progress=None) -> PairFigures:
-        """Figures of the pairs (``i1[j]``, ``i2[j]``) (sample indices) at ``force`` [N] per finger,
+    def evaluate(self, i1, i2, force, progress=None) -> PairFigures:
+        """Figures of the pairs (``i1[j]``, ``i2[j]``) (sample indices) at ``force`` [N] per finger
+        (one force, or one per pair),
         in blocks of :data:`BLOCK` back-substitutions; ``progress(done, total)`` after each."""
         i1, i2 = np.asarray(i1, np.int64), np.asarray(i2, np.int64)
+        forces = np.broadcast_to(np.asarray(force, float), (len(i1),))
         parts = []
         for s in range(0, len(i1), BLOCK):
             a, b = i1[s: s + BLOCK], i2[s: s + BLOCK]
+            force = forces[s: s + BLOCK]
             U, B, d = self.solve(a, b, force)
             closing = np.asarray(B.multiply(U).sum(axis=0)).ravel()
             energy = 0.5 * np.einsum("ij,ij->j", U, self.K @ U)

@@ -53,7 +53,9 @@ def summary_rows(r: Ranking) -> list[tuple[str, str]]:
     """The summary table: the record's figures in display units."""
     rec = r.record
     rows = [("folder", str(r.folder)), ("object", str(rec.get("object", "?"))),
-            ("force per finger [N]", H.fmt(rec.get("force_N"))), ("friction coefficient", H.fmt(rec.get("friction")))]
+            ("force per finger [N]", H.fmt(rec.get("force_N")) if not rec.get("force_range_N") else
+             f"{H.fmt(rec['force_range_N'][0])} to {H.fmt(rec['force_range_N'][1])}: each candidate at its least "
+             "holding force (column force_N)"), ("friction coefficient", H.fmt(rec.get("friction")))]
     if "mass_kg" in rec:
         rows.append(("mass [kg]", H.fmt(rec["mass_kg"])))
     mat = rec.get("material")
@@ -193,7 +195,9 @@ def build_ranking_report(folder: str | PathLike, out: str | PathLike | None = No
     png, _ = figures(r, views)
     n = min(TOP, r.n)
     obj = rec.get("object", r.folder.name)
-    title = title or f"graspdef ranking: {obj} at {H.fmt(rec.get('force_N'))} N per finger"
+    title = title or (f"graspdef ranking: {obj} at {H.fmt(rec.get('force_N'))} N per finger" if not rec.get("force_range_N")
+                      else f"graspdef ranking: {obj} at {H.fmt(rec['force_range_N'][0])} to "
+                           f"{H.fmt(rec['force_range_N'][1])} N per finger")
     body = ["<p class=\"note\">Contents: <a href=\"#summary\">summary</a>, <a href=\"#top\">top ten</a>, "
             "<a href=\"#compliance\">compliance map</a>, <a href=\"#pareto\">Pareto front</a>, "
             "<a href=\"#rigid\">rigid baseline</a>" + (", <a href=\"#recheck\">nonlinear re-check</a>"

@@ -47,6 +47,9 @@ COLUMNS = [
     ("friction_margin_deg", "deg", "rigid baseline: atan(friction) - the larger angle between a contact patch's "
                                    "mean inward normal and the line, at rest (> 0: inside the cone)"),
     ("rigid_rank", "", "rank of the rigid-object baseline (friction margin, then weight torque ratio)"),
+    ("force_N", "N", "squeezing force per finger the figures below are at: the ranking's force, or with a force "
+                     "range the least force in it that holds the candidate against its weight (the range's top "
+                     "if none does)"),
     ("closing_m", "m", "linear: approach of the two contact points along the grasp line at the force"),
     ("indentation_per_finger_m", "m", "closing / 2"),
     ("work_J", "J", "work of the fingers to reach the force: F closing / 2"),
@@ -63,7 +66,7 @@ COLUMNS = [
     ("weight_torque_ratio", "", "weight's torque about the grasp line (gravity across it) / torsional friction "
                                 "of the two contacts"),
     ("weight_slip_ratio", "", "weight / tangential friction of the two contacts: m g / (2 friction F)"),
-    ("held", "", "1: deformed friction margin > 0, both weight ratios < 1 and the strain limit (if any) kept"),
+    ("held", "", "1: deformed friction margin > 0, both weight ratios at most 1 and the strain limit (if any) kept"),
     ("pareto", "", "1: on the Pareto front of (least work, largest deformed friction margin)"),
 ]
 COLUMN_NAMES = [c[0] for c in COLUMNS]

@@ -14,7 +14,7 @@ from ..ranking.screen import PairFigures
 from .run import SweepError, _connect
 
 
-def rank_on_dask(scene, force: float, candidates: int = 2000, out=None, *, scheduler: str | None = None,
+def rank_on_dask(scene, force: float | None, candidates: int = 2000, out=None, *, scheduler: str | None = None,
                  workers: int = 2, chunks: int | None = None, connect_timeout: float = 5.0, **kwargs) -> dict:
     """:func:`graspdef.ranking.rank_object` with the screen run as ``chunks`` Dask tasks (default:
     two per worker) on an embedded LocalCluster of ``workers`` processes or at ``scheduler``."""
@@ -32,9 +32,9 @@ def rank_on_dask(scene, force: float, candidates: int = 2000, out=None, *, sched
         if n_chunks < 1:
             raise SweepError(f"--chunks must be >= 1, got {chunks}")
 
-        def screen_with(first: np.ndarray, second: np.ndarray) -> PairFigures:
+        def screen_with(first: np.ndarray, second: np.ndarray, forces: np.ndarray) -> PairFigures:
             parts = np.array_split(np.arange(len(first)), min(n_chunks, len(first)))
-            futures = [client.submit(screen_chunk, scene_path, force, first[p], second[p], pad_size, pure=False)
+            futures = [client.submit(screen_chunk, scene_path, forces[p], first[p], second[p], pad_size, pure=False)
                        for p in parts]
             results = []
             for k, f in enumerate(futures):

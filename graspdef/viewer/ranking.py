@@ -38,6 +38,14 @@ def _candidate_label(rank: int, candidate: int) -> str:
     return f"rank {rank} · candidate {candidate}"
 
 
+def _force_text(rec: dict) -> str:
+    """The ranking's force: one force, or the range (each candidate at its least holding force)."""
+    fr = rec.get("force_range_N")
+    if fr:
+        return f"{fr[0]:g}-{fr[1]:g} N (each candidate at its least holding force)"
+    return f"{rec.get('force_N', float('nan')):g} N"
+
+
 def row_markdown(row: dict) -> str:
     """A table row's figures as markdown, in display units (mm, mJ, N/mm, %, deg)."""
     def f(v, scale=1.0, digits=4):
@@ -47,6 +55,7 @@ def row_markdown(row: dict) -> str:
     lines = [f"**rank {row['rank']}** (rigid baseline: rank {row['rigid_rank']}) · candidate {row['candidate']}",
              "", "| | |", "|---|---|",
              f"| opening (width) | {f(row['width_m'], MM)} mm |",
+             f"| force per finger | {f(row.get('force_N'))} N |",
              f"| indentation per finger | {f(row['indentation_per_finger_m'], MM)} mm |",
              f"| closing | {f(row['closing_m'], MM)} mm |",
              f"| work | {f(row['work_J'], MM)} mJ |",
@@ -241,7 +250,7 @@ class RankingViewer:
         rec = r.record
         mat = rec.get("material") or {}
         bits = [f"**graspdef ranking** `{r.folder.name}`",
-                f"object **{rec.get('object', '?')}**, {rec.get('force_N', float('nan')):g} N per finger, "
+                f"object **{rec.get('object', '?')}**, {_force_text(rec)} per finger, "
                 f"friction {rec.get('friction', float('nan')):g}, {r.n} candidates"]
         if isinstance(mat, dict) and "E_Pa" in mat:
             bits.append(f"{mat.get('model', '')} E = {mat['E_Pa'] / 1e6:.4g} MPa, ν = {mat.get('nu', '?')}, "
