@@ -13,8 +13,6 @@ and figures are the table's, never recomputed here.  viser is imported when a vi
 """
 from __future__ import annotations
 
-import contextlib
-import io
 import threading
 from os import PathLike
 
@@ -22,7 +20,7 @@ import numpy as np
 
 from ..runs.ranking import Ranking, read_ranking
 from . import layers
-from .server import ViewerError, _import_viser, check_port
+from .server import ViewerError, close_server, open_server, page_url
 
 #: how many candidates are drawn as segments by default (the best ones)
 DEFAULT_TOP = 200
@@ -84,18 +82,11 @@ class RankingViewer:
         if top < 1:
             raise ViewerError(f"--top must be at least 1, got {top}")
         self.top = int(top)
-        viser = _import_viser()
-        check_port(host, port)
         self.host = host
         self._lock = threading.RLock()
         self._stop = threading.Event()
         self._stopped = False
-        with contextlib.redirect_stdout(io.StringIO()):
-            self.server = viser.ViserServer(host=host, port=port, verbose=False)
-        self.port = self.server.get_port()
-        if port != 0 and self.port != port:          # viser moves on to the next free port: refuse
-            self._stop_server()
-            raise ViewerError(f"port {port} on {host} is in use (another viewer?): choose another with --port")
+        self.server, self.port = open_server(host, port)
         try:
             self._build()
         except BaseException:
@@ -105,8 +96,7 @@ class RankingViewer:
     # ---- life cycle ------------------------------------------------------------------------------
     @property
     def url(self) -> str:
-        host = f"[{self.host}]" if ":" in self.host else self.host
-        return f"http://{host}:{self.port}"
+        return page_url(self.host, self.port)
 
     @property
     def runs(self) -> list:
@@ -120,8 +110,7 @@ class RankingViewer:
         self.stop()
 
     def _stop_server(self) -> None:
-        with contextlib.redirect_stdout(io.StringIO()):
-            self.server.stop()
+        close_server(self.server)
 
     def stop(self) -> None:
         """Stop the server and free the port.  Safe to call twice."""

@@ -58,6 +58,29 @@ def check_port(host: str, port: int) -> None:
         s.close()
 
 
+def open_server(host: str, port: int):
+    """(a quiet viser server on ``host``:``port``, its port); a port in use is refused (viser
+    would move on to the next free one), a port of 0 takes any free one."""
+    viser = _import_viser()
+    check_port(host, port)
+    with contextlib.redirect_stdout(io.StringIO()):
+        server = viser.ViserServer(host=host, port=port, verbose=False)
+    got = server.get_port()
+    if port != 0 and got != port:
+        close_server(server)
+        raise ViewerError(f"port {port} on {host} is in use (another viewer?): choose another with --port")
+    return server, got
+
+
+def close_server(server) -> None:
+    with contextlib.redirect_stdout(io.StringIO()):
+        server.stop()
+
+
+def page_url(host: str, port: int) -> str:
+    return f"http://{f'[{host}]' if ':' in host else host}:{port}"
+
+
 class _RunView:
     """Scene nodes, GUI and state of one run."""
 
@@ -255,8 +278,6 @@ class Viewer:
         score_dirs = list(score_dirs) if score_dirs is not None else [None] * len(run_dirs)
         score_dirs += [None] * (len(run_dirs) - len(score_dirs))
         self.runs = [read_run(d, s) for d, s in zip(run_dirs, score_dirs)]
-        viser = _import_viser()
-        check_port(host, port)
         self.host = host
         self.live = live
         self.backend = backend
@@ -267,12 +288,7 @@ class Viewer:
         self._worker: threading.Thread | None = None
         self._stopped = False
         self._syncing = False
-        with contextlib.redirect_stdout(io.StringIO()):
-            self.server = viser.ViserServer(host=host, port=port, verbose=False)
-        self.port = self.server.get_port()
-        if port != 0 and self.port != port:          # viser moves on to the next free port: refuse
-            self._stop_server()
-            raise ViewerError(f"port {port} on {host} is in use (another viewer?): choose another with --port")
+        self.server, self.port = open_server(host, port)
         try:
             self._build()
         except BaseException:
@@ -285,8 +301,7 @@ class Viewer:
     # ---- life cycle ------------------------------------------------------------------------------
     @property
     def url(self) -> str:
-        host = f"[{self.host}]" if ":" in self.host else self.host
-        return f"http://{host}:{self.port}"
+        return page_url(self.host, self.port)
 
     def __enter__(self) -> "Viewer":
         return self
@@ -295,8 +310,7 @@ class Viewer:
         self.stop()
 
     def _stop_server(self) -> None:
-        with contextlib.redirect_stdout(io.StringIO()):
-            self.server.stop()
+        close_server(self.server)
 
     def stop(self) -> None:
         """Stop the worker and the server; free the port.  Safe to call twice."""
