@@ -199,14 +199,7 @@ def _summary_rows(rr: RunReport) -> list[tuple[str, str]]:
         rows.append(("force per finger [N]", H.fmt(rr.force_N)))
     mat = rec.get("material")
     if isinstance(mat, dict):
-        bits = [str(mat.get("model", ""))]
-        if "E_Pa" in mat:
-            bits.append(f"E = {mat['E_Pa'] / 1e6:.4g} MPa")
-        if "nu" in mat:
-            bits.append(f"nu = {mat['nu']:g}")
-        if "thickness_m" in mat:
-            bits.append(f"t = {mat['thickness_m'] * MM:.4g} mm")
-        rows.append(("material", ", ".join(b for b in bits if b)))
+        rows.append(("material", H.material_text(mat)))
     if rec.get("gas_p0_Pa"):
         rows.append(("enclosed air [kPa]", H.fmt(rec["gas_p0_Pa"] / 1e3)))
     rows.append(("surface vertices / faces", f"{len(run.rest_vertices):,} / {len(run.faces):,}"))

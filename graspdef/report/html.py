@@ -98,3 +98,15 @@ def write_page(out_path: Path, text: str) -> Path:
         Path(tmp).unlink(missing_ok=True)
         raise
     return out_path
+
+
+def material_text(mat: dict) -> str:
+    """A run record's material as one line: model, E [MPa], nu, and the thickness [mm] if given."""
+    bits = [str(mat.get("model", ""))]
+    if "E_Pa" in mat:
+        bits.append(f"E = {mat['E_Pa'] / 1e6:.4g} MPa")
+    if "nu" in mat:
+        bits.append(f"nu = {mat['nu']:g}")
+    if "thickness_m" in mat:
+        bits.append(f"t = {mat['thickness_m'] * 1e3:.4g} mm")
+    return ", ".join(b for b in bits if b)

@@ -60,12 +60,7 @@ def summary_rows(r: Ranking) -> list[tuple[str, str]]:
         rows.append(("mass [kg]", H.fmt(rec["mass_kg"])))
     mat = rec.get("material")
     if isinstance(mat, dict):
-        bits = [str(mat.get("model", ""))]
-        if "E_Pa" in mat:
-            bits.append(f"E = {mat['E_Pa'] / 1e6:.4g} MPa")
-        if "nu" in mat:
-            bits.append(f"nu = {mat['nu']:g}")
-        rows.append(("material", ", ".join(b for b in bits if b)))
+        rows.append(("material", H.material_text(mat)))
     elif mat is not None:
         rows.append(("material", str(mat)))
     rows += [("wall thickness [mm]", H.fmt(_num(rec.get("thickness_m"), MM))),
