@@ -20,7 +20,7 @@ import numpy as np
 
 from ..runs.ranking import Ranking, read_ranking
 from . import layers
-from .server import ViewerError, close_server, open_server, page_url
+from .server import ServerPage, ViewerError, open_server
 
 #: how many candidates are drawn as segments by default (the best ones)
 DEFAULT_TOP = 200
@@ -72,7 +72,7 @@ def row_markdown(row: dict) -> str:
     return "\n".join(lines)
 
 
-class RankingViewer:
+class RankingViewer(ServerPage):
     """A running viser page for one ranking folder; ``stop()`` (or leaving the ``with`` block)
     shuts it down.  ``show_candidate(candidate)`` does what the dropdown does."""
 
@@ -94,40 +94,11 @@ class RankingViewer:
             raise
 
     # ---- life cycle ------------------------------------------------------------------------------
-    @property
-    def url(self) -> str:
-        return page_url(self.host, self.port)
 
     @property
     def runs(self) -> list:
         """What the page shows (one ranking), for the command line's progress line."""
         return [self.ranking]
-
-    def __enter__(self) -> "RankingViewer":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.stop()
-
-    def _stop_server(self) -> None:
-        close_server(self.server)
-
-    def stop(self) -> None:
-        """Stop the server and free the port.  Safe to call twice."""
-        with self._lock:
-            if self._stopped:
-                return
-            self._stopped = True
-        self._stop.set()
-        self._stop_server()
-
-    def wait(self) -> None:
-        """Block until interrupted (Ctrl-C) or stopped."""
-        try:
-            while not self._stop.wait(0.5):
-                pass
-        except KeyboardInterrupt:
-            pass
 
     # ---- coordinates -------------------------------------------------------------------------------
     def to_display(self, x: np.ndarray, offset: np.ndarray | None = None) -> np.ndarray:

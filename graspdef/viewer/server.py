@@ -81,6 +81,47 @@ def page_url(host: str, port: int) -> str:
     return f"http://{f'[{host}]' if ':' in host else host}:{port}"
 
 
+class ServerPage:
+    """The life cycle both viewer pages share (runs, ranking): the URL, ``with``, ``stop()`` (safe
+    twice; a page stops its own workers first in :meth:`_before_close`) and ``wait()``.  A page
+    sets ``host``, ``port``, ``server`` (:func:`open_server`), ``_lock``, ``_stop`` and
+    ``_stopped`` in its constructor."""
+
+    @property
+    def url(self) -> str:
+        return page_url(self.host, self.port)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+    def _stop_server(self) -> None:
+        close_server(self.server)
+
+    def _before_close(self) -> None:
+        """What the page stops before its server (workers, live solvers)."""
+
+    def stop(self) -> None:
+        """Stop the page's workers and the server; free the port.  Safe to call twice."""
+        with self._lock:                                 # let a redraw in progress finish
+            if self._stopped:
+                return
+            self._stopped = True
+        self._stop.set()
+        self._before_close()
+        self._stop_server()
+
+    def wait(self) -> None:
+        """Block until interrupted (Ctrl-C) or stopped."""
+        try:
+            while not self._stop.wait(0.5):
+                pass
+        except KeyboardInterrupt:
+            pass
+
+
 class _RunView:
     """Scene nodes, GUI and state of one run."""
 
@@ -263,7 +304,7 @@ def _fmt(v) -> str:
     return "–" if v is None else f"{v:.3g}"
 
 
-class Viewer:
+class Viewer(ServerPage):
     """A running viser page for one or more run folders; use :func:`view`.
 
     ``stop()`` (or leaving the ``with`` block) shuts the server and the worker down."""
@@ -298,27 +339,9 @@ class Viewer:
             self._worker = threading.Thread(target=self._work, name="graspdef-viewer-worker", daemon=True)
             self._worker.start()
 
-    # ---- life cycle ------------------------------------------------------------------------------
-    @property
-    def url(self) -> str:
-        return page_url(self.host, self.port)
-
-    def __enter__(self) -> "Viewer":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.stop()
-
-    def _stop_server(self) -> None:
-        close_server(self.server)
-
-    def stop(self) -> None:
-        """Stop the worker and the server; free the port.  Safe to call twice."""
-        with self._lock:                                 # let a redraw in progress finish
-            if self._stopped:
-                return
-            self._stopped = True
-        self._stop.set()
+    # ---- life cycle (ServerPage) -------------------------------------------------------------------
+    def _before_close(self) -> None:
+        """Stop the live re-solve worker and free the live solvers."""
         with self._wake:
             self._wake.notify_all()
         if self._worker is not None:
@@ -326,15 +349,6 @@ class Viewer:
         for rv in self.views:
             if rv.live is not None:
                 rv.live.close()
-        self._stop_server()
-
-    def wait(self) -> None:
-        """Block until interrupted (Ctrl-C) or stopped."""
-        try:
-            while not self._stop.wait(0.5):
-                pass
-        except KeyboardInterrupt:
-            pass
 
     # ---- scene -------------------------------------------------------------------------------------
     def _build(self) -> None:
