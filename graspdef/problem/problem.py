@@ -17,7 +17,7 @@ from .nitsche import NitscheRotation
 #: refused (loads given to 4 digits balance to ~1e-5; MuJoCo's settled grasps to ~1e-6)
 SELF_EQUILIBRIUM_RTOL = 1e-3
 from .terms import DeadLoads, NitscheTerm, RestQuadratic, ShellElastic
-from .supports import RigidModes, check_rigid_modes, constraint_rows, independent_rows, three_point_supports
+from .supports import RigidModes, check_rigid_modes, constraint_rows, independent_rows
 
 
 #: sparse solver back-ends a problem may ask for (graspdef.solve.sparse implements them)
@@ -158,21 +158,12 @@ class Problem:
         """Nitsche terms for rotation-fixed edges, (3 n_control, 3 n_control) sparse."""
         return NitscheRotation(self.shell, self.supports, self.evaluator).evaluate(self.shell.rest_positions)[2]
 
-    def constraints(self, with_targets: bool = False, rigid: str = "orthogonal"):
+    def constraints(self, with_targets: bool = False):
         """C (m, 3 n_control) and row labels (and, ``with_targets``, the prescribed values g (m,)
         [m] of C u = g at load factor 1); raises SupportError if rigid modes stay free.
-
-        ``rigid``: how RigidModes are imposed -- "orthogonal" (u orthogonal to the rest-state
-        rigid modes; linear theory) or "three_point" (a statically determinate 3-2-1 point
-        support, exact at finite rotations; what the nonlinear solver uses)."""
-        supports = self.supports
-        if rigid == "three_point":
-            supports = []
-            for s in self.supports:
-                supports += three_point_supports(self.shell, self.evaluator, s.name) if isinstance(s, RigidModes) else [s]
-        elif rigid != "orthogonal":
-            raise ProblemError(f"rigid must be 'orthogonal' or 'three_point', got {rigid!r}")
-        C, labels, g = constraint_rows(self.shell, supports, self.evaluator, self.n_collocation,
+        RigidModes are the six surface-mean rows (:func:`graspdef.problem.supports.surface_mean_rows`),
+        in linear and nonlinear solves alike."""
+        C, labels, g = constraint_rows(self.shell, self.supports, self.evaluator, self.n_collocation,
                                        with_targets=True)
         keep = independent_rows(C)
         C, labels, g = C[keep], [labels[i] for i in keep], g[keep]

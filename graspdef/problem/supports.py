@@ -110,9 +110,13 @@ class PointSupport:
 
 @dataclass(frozen=True)
 class RigidModes:
-    """Removes the six rigid-body modes of an unsupported body: the control-point displacements
-    are made orthogonal to the rigid translations and rotations (about the centroid).  Exact for
-    self-equilibrated loads; the load's net force and moment are reported by the solver."""
+    """Removes the six rigid-body modes of an unsupported body without picking vertices: the
+    limit surface's area-weighted mean displacement and mean (linearised) rotation about its
+    area centroid are held at zero (:func:`surface_mean_rows`).  The six rows are invariant to
+    the numbering of the vertices and symmetric under every symmetry of the mesh, and they touch
+    no point in particular.  Their reactions are the net force and moment that the loads leave
+    unbalanced in the current configuration (zero for self-equilibrated loads at any
+    deformation, as for any statically determinate support); they are reported by the solver."""
 
     name: str = "rigid_modes"
 
@@ -120,36 +124,45 @@ class RigidModes:
 Support = EdgeSupport | PointSupport | RigidModes
 
 
-def three_point_supports(shell: Shell, ev: SurfaceEvaluator, name: str = "rigid_modes") -> list:
-    """A statically determinate 3-2-1 support that removes the six rigid-body motions without
-    restraining any deformation: vertex P1 fixed in x, y, z; P2 (farthest from P1) in the two
-    directions normal to P1P2; P3 (farthest from the line P1P2) normal to the plane P1P2P3.
-    Its reactions vanish for self-equilibrated loads, at any deformation -- unlike the
-    orthogonality to the rest-state rigid modes, which is only a linearisation."""
-    x = np.asarray(shell.vertices, float)
-    faces = shell.mesh.faces[: shell.mesh.n_real_faces]
-    c = x.mean(axis=0)
-    i1 = int(np.argmax(np.linalg.norm(x - c, axis=1)))
-    i2 = int(np.argmax(np.linalg.norm(x - x[i1], axis=1)))
-    e = (x[i2] - x[i1]) / np.linalg.norm(x[i2] - x[i1])
-    rel = x - x[i1]
-    i3 = int(np.argmax(np.linalg.norm(rel - np.outer(rel @ e, e), axis=1)))
-    n = np.cross(e, x[i3] - x[i1])
-    if np.linalg.norm(n) < 1e-9 * np.linalg.norm(x[i2] - x[i1]) ** 2:
-        raise SupportError(f"support '{name}': the surface is degenerate (all vertices on a line)")
-    n /= np.linalg.norm(n)
-    m = np.cross(n, e)
-
-    def at_vertex(v):
-        f = int(np.flatnonzero((faces == v).any(axis=1))[0])
-        bary = tuple(float(b) for b in (faces[f] == v))
-        return f, bary
-
-    out = []
-    for v, dirs in ((i1, ((1.0, 0, 0), (0, 1.0, 0), (0, 0, 1.0))), (i2, (tuple(n), tuple(m))), (i3, (tuple(n),))):
-        f, b = at_vertex(v)
-        out.append(PointSupport(f, b, dirs, f"{name}: vertex {v}"))
-    return out
+def surface_mean_rows(shell: Shell) -> tuple[np.ndarray, np.ndarray]:
+    """The six rows of :class:`RigidModes` as dense (6, 3 n_control) arrays, each of unit norm:
+    the mean displacement (1/A) int u dA and the mean rotation int (X - c) x u dA of the rest limit
+    surface (area A, centroid c), integrated with the shell's own quadrature
+    (u = sum_i N_i u_i, so the rows are sum_i m_i u_i and sum_i a_i x u_i with m_i = int N_i dA,
+    a_i = int N_i (X - c) dA).  Returns (rows, the 3 x 3 second moment int |X-c|^2 I - (X-c)(X-c)^T dA)."""
+    n = shell.n_control
+    x = shell.rest_positions
+    m = np.zeros(n)
+    first = np.zeros((n, 3))
+    area = 0.0
+    cen = np.zeros(3)
+    parts = []
+    for g, r in zip(shell.basis.groups, shell.rest):
+        N = np.broadcast_to(g.N, (len(g.stencils),) + g.N.shape[-2:])             # (f, q, S)
+        Xq = np.einsum("fqs,fsd->fqd", N, x[g.stencils])                            # limit points
+        parts.append((g, N, Xq, r.weights))
+        area += float(r.weights.sum())
+        cen += np.einsum("fq,fqd->d", r.weights, Xq)
+    if area <= 0:
+        raise SupportError("rigid_modes: the surface has no area")
+    cen /= area
+    J = np.zeros((3, 3))
+    for g, N, Xq, w in parts:
+        wN = w[..., None] * N                                                       # (f, q, S)
+        np.add.at(m, g.stencils, wN.sum(axis=1))
+        d = Xq - cen
+        np.add.at(first, g.stencils, np.einsum("fqs,fqd->fsd", wN, d))
+        J += np.einsum("fq,fqd,fqe->de", w, d, d)
+    J = np.trace(J) * np.eye(3) - J
+    rows = np.zeros((6, n, 3))
+    for k in range(3):
+        rows[k, :, k] = m
+        e = np.eye(3)[k]
+        # (a x u)_k = e_k . (a x u) = u . (e_k x a)
+        rows[3 + k] = np.cross(e, first)
+    rows = rows.reshape(6, -1)
+    rows /= np.linalg.norm(rows, axis=1, keepdims=True)
+    return rows, J
 
 
 def rigid_modes(x: np.ndarray) -> np.ndarray:
@@ -237,12 +250,13 @@ def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: i
                     targets[m] = float(val)
                 add(st, w, dn, f"{sup.name}: u.{d.tolist()}")
         elif isinstance(sup, RigidModes):
-            R = rigid_modes(x)
-            names = ["translation x", "translation y", "translation z", "rotation x", "rotation y", "rotation z"]
+            R, _ = surface_mean_rows(shell)
+            names = ["mean translation x", "mean translation y", "mean translation z",
+                     "mean rotation x", "mean rotation y", "mean rotation z"]
             for c in range(6):
                 rows.append(np.full(3 * n, m))
                 cols.append(np.arange(3 * n))
-                vals.append(R[:, c])
+                vals.append(R[c])
                 labels.append(f"{sup.name}: {names[c]}")
                 m += 1
         else:

@@ -149,6 +149,8 @@ class NonlinearSolution(DisplacementField):
     path : list of PathPoint (start state first)
     completed : whether ``max_load`` was reached;  stop_reason : why not
     critical_points : detected limit and bifurcation points (dicts)
+    events : every attempt that failed and was cut (from, to, reason): with each point's
+        ``extra["converged_by"]`` the path says why every step stopped where it did
     timings : seconds;  n_factorisations : tangent factorisations
     """
 
@@ -158,6 +160,7 @@ class NonlinearSolution(DisplacementField):
     completed: bool = False
     stop_reason: str | None = None
     critical_points: list = field(default_factory=list)
+    events: list = field(default_factory=list)        # every failed attempt: load factor, step, reason
     timings: dict = field(default_factory=dict)
     n_factorisations: int = 0
 
@@ -205,6 +208,10 @@ class PathSolver:
         self.gas = [t for t in self.eq.terms if isinstance(t, EnclosedGas)]   # pre-loaded at lam = 0
         self.q_norm = 0.0
         self.inertia_residual = 0.0
+        self.floor = 0.0                  # round-off level of the residual [N] (the latest Hessian's)
+        self.converged_by: str | None = None
+        self.residual = (0.0, 0.0)        # (relative residual, relative floor) of the last test
+        self.last_step = np.inf           # |last correction| / |u| of the current Newton solve
 
     # ---------------------------------------------------------------------------------------
     def _record(self, u, lam, state, its, inst, kind="step") -> PathPoint:
@@ -212,6 +219,10 @@ class PathSolver:
         pt = PathPoint(float(lam), x_u.copy(), float(state.energy), int(its), inst, kind)
         # relative residual of the iterate whose factorisation gave the stability (0: this point)
         pt.extra["inertia_residual"] = float(self.inertia_residual)
+        # why Newton stopped here: "residual" (below tol x force scale), "round-off floor" or "start"
+        pt.extra["converged_by"] = self.converged_by or kind
+        pt.extra["residual_relative"] = float(self.residual[0])
+        pt.extra["roundoff_floor_relative"] = float(self.residual[1])
         if self.eq.m and np.any(self.eq.g):               # reactions of prescribed displacements
             _, mu = self.eq.projected_residual(state.gradient)
             for i in np.flatnonzero(self.eq.g):
@@ -229,14 +240,32 @@ class PathSolver:
         return pt
 
     def _converged(self, state, u, lam) -> tuple[bool, float]:
+        """Whether (u, lam) is an equilibrium, and the relative residual.
+
+        The residual |grad Pi + C^T mu| (reactions mu by least squares) is compared with the
+        problem's own force scale: the largest of the applied load, the internal (elastic and
+        support) forces and the reactions -- and accepted below ``tol`` times it ("residual") or
+        below the round-off level of the forces themselves ("round-off floor",
+        :func:`graspdef.solve.equilibrium.roundoff_floor`, from the latest Hessian: for a thin stiff
+        shell at small loads the relative residual cannot fall below ~1e-5, and no tolerance
+        should have to be loosened by hand for it).  Sets ``self.converged_by``."""
+        self.floor = self.eq.floor
         r, mu = self.eq.projected_residual(state.gradient)
         scale = max(abs(lam) * float(np.linalg.norm(state.load)), float(np.linalg.norm(state.internal)),
                     float(np.linalg.norm(self.eq.C.T @ mu)) if self.eq.m else 0.0, 1e-300)
         rn = float(np.linalg.norm(r))
         cres = self.eq.constraint_residual(u, lam)
         cscale = max(float(np.linalg.norm(lam * self.eq.g)), float(np.linalg.norm(u)), 1e-300)
-        ok = (rn <= self.opt.tol * scale or rn <= 1e-13 * max(self.q_norm, 1e-300)) and \
-            float(np.linalg.norm(cres)) <= 1e-9 * cscale
+        how = None
+        if rn <= self.opt.tol * scale:
+            how = "residual"
+        elif rn <= self.floor and self.last_step <= self.opt.tol:
+            how = "round-off floor"       # and the last correction moved nothing: |du| <= tol |u|
+        elif rn <= 1e-13 * max(self.q_norm, 1e-300):
+            how = "absolute"
+        ok = how is not None and float(np.linalg.norm(cres)) <= 1e-9 * cscale
+        self.converged_by = how if ok else None
+        self.residual = (rn / scale, self.floor / scale)
         return ok, rn / scale
 
     def newton(self, u0: np.ndarray, lam: float, factored: bool = False):
@@ -266,6 +295,7 @@ class PathSolver:
         hist: list[tuple[np.ndarray, np.ndarray]] = []      # (u_k, du_k) since the factorisation
         back = None                                          # state before an Anderson step
         near = None                 # inertia of a factorisation at an iterate within inertia_rtol
+        self.last_step = np.inf
         for it in range(opt.max_iterations + 1):
             st = eq.evaluate(u, lam, 2 if need_h else 1)
             if not np.isfinite(st.energy) or not np.all(np.isfinite(st.gradient)):
@@ -338,10 +368,11 @@ class PathSolver:
                 step = alpha * du
             if feasible and opt.reuse_factorisation:
                 hist = ([(u, du)] + hist)[: opt.anderson]
-            log.debug("  newton it %d lam %.6g rel %.2e alpha %.3g |du| %.3e tangent %s%s", it, lam, rel, alpha,
+            log.debug("  newton it %d lam %.6g rel %.2e (floor %.2e) alpha %.3g |du| %.3e tangent %s%s", it, lam, rel, self.residual[1], alpha,
                       float(np.linalg.norm(du)), "new" if need_h else "reused",
                       f" (Anderson {len(hist) - 1})" if len(hist) > 1 else "")
             u = u + step
+            self.last_step = float(np.linalg.norm(step)) / max(float(np.linalg.norm(u)), 1e-300)
             prev = rel
             need_h = not opt.reuse_factorisation
         raise _Failed(f"Newton did not converge in {opt.max_iterations} iterations at load factor "
@@ -467,6 +498,8 @@ class PathSolver:
                 if abs(step) / 2 < dmin:
                     raise _Failed(f"load step cut below {dmin:.3g} at load factor {lam:.6g}: {exc}") from None
                 log.info("step to %.6g failed (%s); halving", lam_new, exc)
+                sol.events.append({"from_load_factor": float(lam), "to_load_factor": float(lam_new),
+                                   "action": "load step halved", "reason": str(exc)})
                 dlam = step / 2
                 continue
             is_target = abs(lam_new - nxt) <= 1e-12 * abs(lam_end)
@@ -506,6 +539,8 @@ class PathSolver:
                 if dl / 2 < dl_min:
                     raise _Failed(f"arc length cut below {dl_min:.3g} at load factor {lam:.6g}: {exc}") from None
                 log.info("arc step %.3g from lam %.6g failed (%s); halving", dl, lam, exc)
+                sol.events.append({"from_load_factor": float(lam), "arc_length": float(dl),
+                                   "action": "arc length halved", "reason": str(exc)})
                 dl /= 2
                 continue
             # requested load levels crossed by this step: land on them exactly
@@ -572,6 +607,7 @@ class PathSolver:
         dlam = sgn * dl / tn
         Du = dlam * t
         Dlam = dlam
+        self.last_step = np.inf
         for it in range(1, opt.max_iterations + 1):
             un, ln = u + Du, lam + Dlam
             st = eq.evaluate(un, ln, 2)
@@ -593,7 +629,9 @@ class PathSolver:
                 raise _Failed(f"no real root of the arc-length constraint near load factor {ln:.6g}")
             roots = [(-b + s * np.sqrt(disc)) / (2 * a) for s in (1.0, -1.0)]
             best = max(roots, key=lambda r: float((Du + dR + r * dF) @ Du))
-            Du = Du + dR + best * dF
+            corr = dR + best * dF
+            Du = Du + corr
+            self.last_step = float(np.linalg.norm(corr)) / max(float(np.linalg.norm(u + Du)), 1e-300)
             Dlam = Dlam + best
         raise _Failed(f"arc-length corrector did not converge in {opt.max_iterations} iterations near load "
                       f"factor {lam + Dlam:.6g} (relative residual {rel:.2e})")
