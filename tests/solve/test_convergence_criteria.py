@@ -80,7 +80,6 @@ def test_slit_ring_runs_with_the_default_tolerance(ring):
     assert abs(wa - wa_lin) <= 0.01 * abs(wa_lin)
 
 
-@pytest.mark.slow
 def test_slit_ring_lifted_to_full_load_with_default_settings():
     """The whole path to P = 0.8 with default settings completes (it stopped at its first step
     before), and W_A at P_max is close to Sze, Liu & Lo (2004)'s S4R reference, problem 3.3
