@@ -175,10 +175,11 @@ class Equilibrium:
                 neg = neg + int((np.linalg.eigvalsh(-S) < 0).sum()) - int((c > 0).sum())
         return None if neg is None else neg - self.m
 
-    def solve(self, rhs: np.ndarray, g: np.ndarray | None = None) -> np.ndarray:
+    def solve(self, rhs: np.ndarray, g: np.ndarray | None = None, rtol: float = 1e-8) -> np.ndarray:
         """Solve (H + sum c v v^T) du + C^T l = rhs, C du = g with the last factorisation;
-        ``rhs`` (n,) or (n, k)."""
-        du, _, _ = self.kkt.solve(rhs, g)
+        ``rhs`` (n,) or (n, k); ``rtol``: the largest relative residual accepted (a nearly singular
+        tangent, at a critical point, needs a looser one for inverse iteration)."""
+        du, _, _ = self.kkt.solve(rhs, g, rtol=rtol)
         if self._lowrank is not None:
             V, W, S = self._lowrank
             du = du - W @ np.linalg.solve(S, V.T @ du)

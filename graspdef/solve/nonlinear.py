@@ -33,6 +33,7 @@ from .result import DisplacementField
 log = logging.getLogger(__name__)
 
 METHODS = ("load", "arc_length")
+BIFURCATION = ("report", "locate", "switch")
 
 
 class PathStopped(SolverError):
@@ -64,6 +65,12 @@ class PathOptions:
     anderson : depth of the Anderson mixing of the modified-Newton corrections (0: plain)
     inertia_rtol : the stability of a point is the inertia of a Hessian factorised within this
         relative residual of it (0: at the converged state itself); see :meth:`PathSolver.newton`
+    bifurcation : what a load-controlled path does at a change of stability that is not a limit
+        point -- "report" (the bracket of the two path points), "locate" (bisect the load step
+        ``refine_critical`` times: the bracket shrinks by 2^-refine_critical) or "switch" (locate,
+        then leave the fundamental path along the critical eigenvector -- inverse iteration on the
+        tangent at the critical point -- and follow the secondary branch by arc length to
+        ``max_load``)
     refine_critical : arc-length bisections that narrow a change of stability down (each halves
         the bracket; the load factor at a limit point is then accurate to O(bracket^2))
     """
@@ -81,6 +88,7 @@ class PathOptions:
     line_search: bool = True
     max_probe_displacement: float | None = None
     refine_critical: int = 12
+    bifurcation: str = "report"
     reuse_factorisation: bool = True
     reuse_ratio: float = 0.9
     anderson: int = 5
@@ -101,6 +109,8 @@ class PathOptions:
             raise ProblemError(f"min_step must lie in (0, 1), got {self.min_step!r}")
         if not isinstance(self.anderson, (int, np.integer)) or self.anderson < 0:
             raise ProblemError(f"anderson must be a non-negative integer, got {self.anderson!r}")
+        if self.bifurcation not in BIFURCATION:
+            raise ProblemError(f"bifurcation must be one of {', '.join(BIFURCATION)}, got {self.bifurcation!r}")
         if not (0 <= self.inertia_rtol < 1e-2):
             raise ProblemError(f"inertia_rtol must lie in [0, 1e-2), got {self.inertia_rtol!r}")
         if not (0 < self.reuse_ratio < 1):
@@ -131,7 +141,9 @@ class PathPoint:
     energy: float                    # total potential energy Pi [J]
     iterations: int                  # Newton iterations of the step that produced it
     instability: int | None          # negative eigenvalues on the constraint null space (0: stable)
-    kind: str = "step"               # "step" or "target" (landed exactly on a requested load)
+    kind: str = "step"               # "step", "target" (landed exactly on a requested load),
+    #                                  "refine" (narrowing a critical point), "branch" (first point
+    #                                  after a branch switch), "start"
     probes: dict = field(default_factory=dict)
     extra: dict = field(default_factory=dict)
 
@@ -212,6 +224,7 @@ class PathSolver:
         self.converged_by: str | None = None
         self.residual = (0.0, 0.0)        # (relative residual, relative floor) of the last test
         self.last_step = np.inf           # |last correction| / |u| of the current Newton solve
+        self.switched = False             # a branch switch has been made (one per path)
 
     # ---------------------------------------------------------------------------------------
     def _record(self, u, lam, state, its, inst, kind="step") -> PathPoint:
@@ -399,6 +412,8 @@ class PathSolver:
     def _detect(sol):
         """Every change of stability between consecutive path points."""
         for i in range(1, len(sol.path)):
+            if sol.path[i].kind == "branch":       # the first point after a branch switch
+                continue
             a, b = sol.path[i - 1].instability, sol.path[i].instability
             if a is not None and b is not None and a != b:
                 sol.critical_points.append({"index": i, "instability_before": a, "instability_after": b})
@@ -420,6 +435,7 @@ class PathSolver:
             cp["bracket"] = [float(lam[i - 1]), float(lam[i])]
             p = sol.path[k] if turned else sol.path[i]
             cp["probes"] = {name: np.asarray(v).tolist() for name, v in p.probes.items()}
+            cp["branch_switched"] = (not turned and any(q.kind == "branch" for q in sol.path[i:]))
             log.info("%s at load factor %.6g (negative eigenvalues %d -> %d)", cp["kind"], cp["load_factor"],
                      cp["instability_before"], cp["instability_after"])
 
@@ -504,6 +520,15 @@ class PathSolver:
                 continue
             is_target = abs(lam_new - nxt) <= 1e-12 * abs(lam_end)
             pt = self._record(u_new, lam_new, st, its, inst, "target" if is_target and nxt != lam_end else "step")
+            last = sol.path[-1].instability
+            if opt.bifurcation != "report" and last is not None and inst is not None and inst != last:
+                refined, crit = self._locate(u, lam, u_new, lam_new, last)
+                sol.path += refined
+                if opt.bifurcation == "switch" and crit is not None and not self.switched:
+                    self.switched = True
+                    self._arc_length(sol, crit[0], crit[1], mode=self._critical_mode(*crit))
+                    return
+                factored = False
             sol.path.append(pt)
             self.eq.commit(u_new)
             self._emit(sol, pt)
@@ -516,13 +541,14 @@ class PathSolver:
             dlam = step * growth if abs(step) >= abs(dlam) * 0.999 else dlam
         raise _Failed(f"the path needed more than max_steps={opt.max_steps} steps (reached load factor {lam:.6g})")
 
-    def _arc_length(self, sol, u):
+    def _arc_length(self, sol, u, lam=0.0, mode=None):
+        """Arc-length continuation from the converged (u, lam); with ``mode`` (a branch switch at
+        a bifurcation point) the first predictor is that eigenvector instead of the tangent."""
         opt = self.opt
         eq = self.eq
         lam_end = opt.max_load
         sgn_end = np.sign(lam_end)
-        lam = 0.0
-        t = self._tangent(u, lam)                      # du/dlam at rest
+        t = self._tangent(u, lam)                      # du/dlam here
         dl0 = abs(lam_end / opt.steps) * float(np.linalg.norm(t))
         if dl0 == 0:
             raise _Failed("zero tangent at the start: the loads do not deform the shell")
@@ -531,6 +557,15 @@ class PathSolver:
         dl_max = dl0 * 8
         du_prev = t * np.sign(lam_end)
         dlam_prev = float(sgn_end)
+        if mode is not None:
+            # leave along the mode: the first step moves the mode's largest control point by
+            # 1 % of the body's size, and the corrector keeps that distance from the critical
+            # point (off the fundamental path, whose steps may be tiny: a strip's axial shortening)
+            size = float(np.ptp(eq.X, axis=0).max())
+            phi = mode.reshape(-1, 3)
+            dl = 1e-2 * size * float(np.linalg.norm(mode)) / float(np.linalg.norm(phi, axis=1).max())
+            dl_min, dl_max = dl * opt.min_step, max(dl_max, 64 * dl)
+            du_prev, dlam_prev = mode / float(np.linalg.norm(mode)), 0.0
         targets = [s for s in self._stop_points()]
         while len(sol.path) <= opt.max_steps:
             try:
@@ -560,9 +595,10 @@ class PathSolver:
                     self.eq.commit(u_t)
                     return
             last = sol.path[-1].instability
-            if opt.refine_critical and last is not None and inst is not None and inst != last:
+            if opt.refine_critical and last is not None and inst is not None and inst != last and mode is None:
                 sol.path += self._bracket(u, lam, dl, du_prev, dlam_prev, last)
-            pt = self._record(u_new, lam_new, st, its, inst, "step")
+            pt = self._record(u_new, lam_new, st, its, inst, "step" if mode is None else "branch")
+            mode = None
             sol.path.append(pt)
             eq.commit(u_new)
             self._emit(sol, pt, dl)
@@ -573,6 +609,52 @@ class PathSolver:
             dl = float(np.clip(dl * np.sqrt(opt.desired_iterations / max(its, 1)), dl / 2,
                                min(dl * opt.max_growth, dl_max)))
         raise _Failed(f"the path needed more than max_steps={opt.max_steps} steps (reached load factor {lam:.6g})")
+
+    def _locate(self, u_a, lam_a, u_b, lam_b, inst_a):
+        """Bisect the load step from the converged (u_a, lam_a) (instability inst_a) to (u_b, lam_b)
+        (another instability) ``refine_critical`` times; returns the new path points in load order
+        and (u, lam) of the point past the change closest to it (None if no bisection converged)."""
+        a_side, b_side = [], []
+        crit = (u_b, lam_b)
+        for _ in range(self.opt.refine_critical):
+            lam_m = 0.5 * (lam_a + lam_b)
+            try:
+                u_m, st, its, inst = self.newton(0.5 * (u_a + u_b), lam_m)
+            except (_Failed, SolverError):
+                break
+            pt = self._record(u_m, lam_m, st, its, inst, "refine")
+            if inst == inst_a:
+                a_side.append(pt)
+                u_a, lam_a = u_m, lam_m
+            else:
+                b_side.append(pt)
+                u_b, lam_b = u_m, lam_m
+                crit = (u_m, lam_m)
+        return a_side + b_side[::-1], crit
+
+    def _critical_mode(self, u, lam, iterations: int = 30, rtol: float = 1e-8) -> np.ndarray:
+        """The eigenvector of the tangent (on the supports' null space) whose eigenvalue is closest
+        to zero at (u, lam) -- the critical mode just past a bifurcation point -- by inverse
+        iteration on the KKT factorisation (each iteration one back-substitution)."""
+        st = self.eq.evaluate(u, lam, 2)
+        self.eq.factor(st)
+        rng = np.random.default_rng(0)                    # a fixed start: reproducible
+        v = rng.standard_normal(self.eq.n)
+        zero = np.zeros(self.eq.m)
+        # the tangent is nearly singular here (that is the point): only the direction of each
+        # solve matters, so its residual check is loose
+        v = self.eq.solve(v, zero, rtol=1e-3)
+        v /= np.linalg.norm(v)
+        for _ in range(iterations):
+            w = self.eq.solve(v, zero, rtol=1e-3)
+            w /= np.linalg.norm(w)
+            if float(w @ v) < 0:
+                w = -w
+            done = float(np.linalg.norm(w - v)) <= rtol ** 0.5
+            v = w
+            if done:
+                break
+        return v
 
     def _bracket(self, u, lam, dl, du_prev, dlam_prev, inst_a):
         """Bisect the arc length from the stable side (u, lam) towards a change of stability;
@@ -603,10 +685,14 @@ class PathSolver:
         tn = float(np.linalg.norm(t))
         if tn == 0:
             raise _Failed("zero tangent")
-        sgn = 1.0 if float(t @ du_prev) >= 0 else -1.0
-        dlam = sgn * dl / tn
-        Du = dlam * t
-        Dlam = dlam
+        if dlam_prev == 0.0:                      # branch switch: predictor along the mode
+            Du = dl * du_prev / float(np.linalg.norm(du_prev))
+            Dlam = 0.0
+        else:
+            sgn = 1.0 if float(t @ du_prev) >= 0 else -1.0
+            dlam = sgn * dl / tn
+            Du = dlam * t
+            Dlam = dlam
         self.last_step = np.inf
         for it in range(1, opt.max_iterations + 1):
             un, ln = u + Du, lam + Dlam
