@@ -146,6 +146,7 @@ class PathPoint:
     #                                  after a branch switch), "start"
     probes: dict = field(default_factory=dict)
     extra: dict = field(default_factory=dict)
+    converged_by: str = ""           # "residual", "round-off floor" (see PathSolver._converged), "start"
 
     @property
     def stable(self) -> bool | None:
@@ -232,8 +233,10 @@ class PathSolver:
         pt = PathPoint(float(lam), x_u.copy(), float(state.energy), int(its), inst, kind)
         # relative residual of the iterate whose factorisation gave the stability (0: this point)
         pt.extra["inertia_residual"] = float(self.inertia_residual)
-        # why Newton stopped here: "residual" (below tol x force scale), "round-off floor" or "start"
-        pt.extra["converged_by"] = self.converged_by or kind
+        # why Newton stopped here: "residual" (below tol x force scale), "round-off floor" or "start";
+        # path.csv carries the numbers (at_roundoff_floor 1/0)
+        pt.converged_by = self.converged_by or kind
+        pt.extra["at_roundoff_floor"] = float(self.converged_by == "round-off floor")
         pt.extra["residual_relative"] = float(self.residual[0])
         pt.extra["roundoff_floor_relative"] = float(self.residual[1])
         if self.eq.m and np.any(self.eq.g):               # reactions of prescribed displacements

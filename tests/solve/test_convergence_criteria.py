@@ -68,7 +68,8 @@ def test_slit_ring_runs_with_the_default_tolerance(ring):
     Sze's S4R curve is still straight there: 1.305 at 0.025)."""
     sol = solve_nonlinear(ring, PathOptions(max_load=0.002, steps=2))
     assert sol.completed
-    how = [p.extra["converged_by"] for p in sol.path[1:]]
+    how = [p.converged_by for p in sol.path[1:]]
+    assert [p.extra["at_roundoff_floor"] for p in sol.path[1:]] == [float(h == "round-off floor") for h in how]
     assert set(how) <= {"residual", "round-off floor"} and "round-off floor" in how
     for p in sol.path[1:]:
         assert p.extra["residual_relative"] <= max(1e-8, p.extra["roundoff_floor_relative"])
