@@ -36,7 +36,8 @@ def _loaded(body: str, watch: tuple[str, ...]) -> dict:
     env = {k: v for k, v in os.environ.items()
            if k not in ("OMP_WAIT_POLICY", "PYPARDISO_MKL_RT", "NUMBA_THREADING_LAYER")}
     code = f"WATCH = {watch!r}\n{body}{REPORT}"
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=ROOT)
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=ROOT,
+                       check=False)
     assert r.returncode == 0, r.stderr
     return json.loads(r.stdout.strip().splitlines()[-1])
 
@@ -62,7 +63,8 @@ def test_help_imports_no_subcommand_module():
 
 
 def test_help_lists_every_subcommand_with_its_line():
-    r = subprocess.run([sys.executable, "-m", "graspdef.cli", "--help"], capture_output=True, text=True, cwd=ROOT)
+    r = subprocess.run([sys.executable, "-m", "graspdef.cli", "--help"], capture_output=True, text=True, cwd=ROOT,
+                       check=False)
     assert r.returncode == 0, r.stderr
     text = " ".join(r.stdout.split())                      # argparse wraps the lines
     for name, (_, line) in COMMANDS.items():

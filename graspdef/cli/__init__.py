@@ -37,8 +37,8 @@ COMMANDS = {
     "view": ("view", "serve run folders or a ranking folder in the browser (viser on 127.0.0.1:8080)"),
     "report": ("report", "write a self-contained HTML report of run folders or of a ranking folder (report.html)"),
     "sweep": ("sweep", "run a grid of grasps (objects x forces x materials x contacts x meshes)"),
-    "object": ("obj", "add an object of your own from a mesh file (object add), or show an object's data "
-                      "(object show)"),
+    "object": ("obj", ("add an object of your own from a mesh file (object add), or show an object's data "
+                       "(object show)")),
     "rank": ("rank", "rank antipodal grasp candidates of an object by the work its shell takes (linear screen)"),
 }
 
