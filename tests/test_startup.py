@@ -53,6 +53,19 @@ def test_import_graspdef_loads_no_heavy_package():
     assert out == {"loaded": [], "cli": []}
 
 
+def test_every_room_is_a_lazy_attribute():
+    """``graspdef.<room>`` works for every room of ARCHITECTURE.md (but cli and testing), and
+    ``import graspdef`` imports none of them (the attribute imports it on first use)."""
+    rooms = {p.stem for p in (ROOT / "graspdef").iterdir()
+             if (p.suffix == ".py" or (p / "__init__.py").is_file()) and not p.name.startswith("__")}
+    out = _loaded("import graspdef\nWATCH = tuple(f'graspdef.{r}' for r in graspdef._SUBPACKAGES)\n", HEAVY)
+    assert out["loaded"] == []
+    import graspdef
+    assert rooms - {"cli", "testing", "errors"} == graspdef._SUBPACKAGES
+    assert graspdef._SUBPACKAGES <= set(dir(graspdef))
+    assert graspdef.units.length_scale("mm") == 1e-3
+
+
 def test_building_the_whole_parser_loads_no_heavy_package():
     """``build_parser()`` imports every subcommand module, and they import their libraries only in ``run``."""
     out = _loaded("import graspdef.cli\ngraspdef.cli.build_parser()\n", HEAVY)
