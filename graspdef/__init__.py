@@ -44,8 +44,10 @@ _LAZY = {
     "solve_linear": "graspdef.solve.linear",
     "view": "graspdef.viewer",
 }
-_SUBPACKAGES = {"geometry", "subdivision", "shell", "problem", "solve", "contact", "sim", "scans", "registration",
-                "viewer", "report", "pipeline", "sweep", "axisym", "runtime"}
+#: the rooms (ARCHITECTURE.md) reachable as ``graspdef.<room>``, imported on first use (not cli, testing)
+_SUBPACKAGES = {"units", "runtime", "config", "geometry", "runs", "subdivision", "shell", "axisym", "problem", "solve",
+                "contact", "sim", "scans", "registration", "objects", "viewer", "report", "pipeline", "ranking",
+                "sweep", "bench"}
 
 __all__ = sorted(["GraspdefError", "MeshError", "ProblemError", "SolverError", "SupportError", *_LAZY])
 

@@ -1,6 +1,6 @@
-"""The ``graspdef`` command line: one module per subcommand, each with ``HELP``, ``DESCRIPTION``,
-``add_arguments(parser)`` and ``run(args) -> int``.  argparse stops here: a subcommand turns its
-arguments into typed inputs and calls a library function.
+"""The ``graspdef`` command line: one module per subcommand, each with ``DESCRIPTION``,
+``add_arguments(parser)`` and ``run(args) -> int``; its one-line help is in :data:`COMMANDS`.
+argparse stops here: a subcommand turns its arguments into typed inputs and calls a library function.
 
     graspdef solve PROBLEM.toml --out DIR      solve one problem file (linear or nonlinear path)
     graspdef bench linear|nonlinear|axisym [--json FILE]   run a benchmark set, print the table
@@ -14,20 +14,33 @@ arguments into typed inputs and calls a library function.
     graspdef rank OBJECT --force F --out DIR   where to grasp: antipodal candidates ranked (linear screen)
 
 Every error a user can cause prints one line ``graspdef: error: ...`` and exits with status 2.
-Building the parser imports no numerical package (``graspdef --help`` stays fast).
+Building the parser imports no numerical package, and :func:`main` imports the module of the one
+subcommand it runs, none for ``graspdef --help`` (start-up stays fast; tests/test_startup.py).
 """
 from __future__ import annotations
 
 import argparse
+import importlib
 import logging
 import sys
+from collections.abc import Iterable, Sequence
 
 from ..errors import GraspdefError
-from . import bench, grasp, obj, rank, report, score, solve, sweep, view
 
-#: subcommands in the order of ``graspdef --help``
-COMMANDS = {"solve": solve, "bench": bench, "score": score, "grasp": grasp, "view": view, "report": report,
-            "sweep": sweep, "object": obj, "rank": rank}
+#: subcommand -> (its module in graspdef.cli, its one-line help), in the order of ``graspdef --help``.
+#: The help lines live here, not in the modules, so that listing the subcommands imports none of them.
+COMMANDS = {
+    "solve": ("solve", "solve a problem file (TOML) and write a run folder"),
+    "bench": ("bench", "run a benchmark set and print/write the comparison table"),
+    "score": ("score", "register a scan to a predicted surface and score it (score.json)"),
+    "grasp": ("grasp", "MuJoCo grasp -> contacts -> shell deformation (a run folder)"),
+    "view": ("view", "serve run folders or a ranking folder in the browser (viser on 127.0.0.1:8080)"),
+    "report": ("report", "write a self-contained HTML report of run folders or of a ranking folder (report.html)"),
+    "sweep": ("sweep", "run a grid of grasps (objects x forces x materials x contacts x meshes)"),
+    "object": ("obj", ("add an object of your own from a mesh file (object add), or show an object's data "
+                       "(object show)")),
+    "rank": ("rank", "rank antipodal grasp candidates of an object by the work its shell takes (linear screen)"),
+}
 
 EPILOG = """examples:
   graspdef solve benchmarks/plate_ss_uniform.toml --out out/plate
@@ -44,14 +57,36 @@ EPILOG = """examples:
 """
 
 
-def build_parser() -> argparse.ArgumentParser:
+def command_module(name: str):
+    """The module of subcommand ``name`` (``graspdef.cli.solve`` for ``solve``), imported now."""
+    return importlib.import_module(f"{__name__}.{COMMANDS[name][0]}")
+
+
+def requested_command(argv: Sequence[str]) -> str | None:
+    """The subcommand an argument list asks for: its first word that is not an option (the options
+    before a subcommand, ``-q`` and ``-h``, take no value); None when there is none or it is not a
+    subcommand (argparse then prints the help or the error, as for any other parser)."""
+    word = next((a for a in argv if not a.startswith("-")), None)
+    return word if word in COMMANDS else None
+
+
+def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentParser:
+    """The ``graspdef`` parser with the arguments of ``commands`` (default: every subcommand).
+
+    Only their modules are imported, with ``run`` as ``func``; every other subcommand gets its
+    one-line help alone, so ``--help`` still lists them all."""
     ap = argparse.ArgumentParser(prog="graspdef", description="Robot-grasp deformation simulator: "
                                  "Loop-subdivision Kirchhoff-Love thin shells.", epilog=EPILOG,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
     sub = ap.add_subparsers(dest="command", required=True)
-    for name, mod in COMMANDS.items():
-        p = sub.add_parser(name, help=mod.HELP, description=mod.DESCRIPTION)
+    full = set(COMMANDS if commands is None else commands)
+    for name, (_, help_line) in COMMANDS.items():
+        if name not in full:
+            sub.add_parser(name, help=help_line)
+            continue
+        mod = command_module(name)
+        p = sub.add_parser(name, help=help_line, description=mod.DESCRIPTION)
         mod.add_arguments(p)
         p.set_defaults(func=mod.run)
     return ap
@@ -60,7 +95,9 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """``graspdef ...``: parse, run the subcommand; a GraspdefError or OSError is one line and
     exit status 2."""
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    command = requested_command(argv)
+    args = build_parser([command] if command else []).parse_args(argv)
     from .. import runtime
 
     runtime.configure()             # before any numerical runtime starts (graspdef.runtime)

@@ -7,8 +7,7 @@ from pathlib import Path
 
 from ._common import progress
 
-HELP = "run a benchmark set and print/write the comparison table"
-DESCRIPTION = HELP
+DESCRIPTION = "run a benchmark set and print/write the comparison table"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

@@ -5,7 +5,6 @@ import argparse
 
 from ._common import progress, warn
 
-HELP = "MuJoCo grasp -> contacts -> shell deformation (a run folder)"
 DESCRIPTION = ("Close the scene's gripper to the force per finger, settle, map the contacts onto the object's shell "
                "and solve; writes a run folder.")
 

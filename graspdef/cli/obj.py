@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-HELP = "add an object of your own from a mesh file (object add), or show an object's data (object show)"
 DESCRIPTION = ("object add: repair and remesh a mesh file into a Loop control mesh, make its collision geometry, "
                "mass and inertia, place it between the gripper's fingers and write a self-contained folder that "
                "'graspdef grasp FOLDER' runs.  object show: print, with units and sources, what 'graspdef grasp' "

@@ -5,7 +5,6 @@ import argparse
 
 from ._common import progress
 
-HELP = "rank antipodal grasp candidates of an object by the work its shell takes (linear screen)"
 DESCRIPTION = ("Sample antipodal grasp candidates on the object's surface (within the gripper's opening and the "
                "friction cone, reachable from outside), screen each with the linear shell (one factorisation, "
                "back-substitutions in blocks) and rank them: those that hold (deformed friction margin, the "

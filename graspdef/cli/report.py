@@ -6,7 +6,6 @@ import argparse
 
 from ._common import progress, warn
 
-HELP = "write a self-contained HTML report of run folders or of a ranking folder (report.html)"
 DESCRIPTION = ("One HTML page (pictures inlined, no external URL): the deformed surface coloured by displacement and "
                "by scan error, load-deflection and convergence plots, and a table in the layout of Tian & Jia's "
                "Table I for several grasp runs. A ranking folder (graspdef rank --out) gets its own page: summary, top ten, "

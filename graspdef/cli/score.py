@@ -5,7 +5,6 @@ import argparse
 
 from ._common import progress
 
-HELP = "register a scan to a predicted surface and score it (score.json)"
 DESCRIPTION = ("Rigid registration (open3d ICP) of a scan to a predicted surface; writes score.json and per-vertex "
                "errors, with the undeformed shape as the baseline.")
 

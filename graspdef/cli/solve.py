@@ -7,7 +7,6 @@ from pathlib import Path
 
 from ._common import progress, warn
 
-HELP = "solve a problem file (TOML) and write a run folder"
 DESCRIPTION = "Solve a problem file and write result.json, deformed.ply and a copy of the problem into --out."
 
 

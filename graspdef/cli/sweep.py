@@ -8,7 +8,6 @@ from pathlib import Path
 from ..errors import ProblemError
 from ._common import progress
 
-HELP = "run a grid of grasps (objects x forces x materials x contacts x meshes)"
 DESCRIPTION = ("Run every case of a sweep spec (TOML) in parallel -- an embedded local cluster, or a dask.distributed "
                "cluster with --scheduler -- into a resumable sweep folder: one run folder per case, results.csv and "
                "summary.md.")

@@ -7,7 +7,6 @@ import argparse
 from ..errors import GraspdefError
 from ._common import progress
 
-HELP = "serve run folders or a ranking folder in the browser (viser on 127.0.0.1:8080)"
 DESCRIPTION = ("Serve run folders as a viser page (127.0.0.1 unless --host); Ctrl-C stops it. A ranking folder "
                "(graspdef rank --out) shows the compliance map, the ranked candidates and the stored deformed shapes.")
 

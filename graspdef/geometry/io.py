@@ -8,7 +8,6 @@ from os import PathLike
 from pathlib import Path
 
 import numpy as np
-import trimesh
 
 from graspdef.errors import MeshError, ProblemError
 from graspdef.geometry.mesh import TriMesh
@@ -62,6 +61,8 @@ def load_mesh(path: str | PathLike, units: str) -> TriMesh:
     path = Path(path)
     if not path.is_file():
         raise ProblemError(f"mesh file not found: {path}")
+    import trimesh  # here, not at import: it costs ~0.2-0.7 s and most runs never read a mesh file
+
     try:
         loaded = trimesh.load(path, process=False, force="mesh")
         vertices, faces = np.asarray(loaded.vertices), np.asarray(loaded.faces)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-import trimesh
 
 
 def shell_inertia(vertices: np.ndarray, faces: np.ndarray, areal_density: float):
@@ -24,6 +23,8 @@ def shell_inertia(vertices: np.ndarray, faces: np.ndarray, areal_density: float)
 def solid_inertia(vertices: np.ndarray, faces: np.ndarray, density: float):
     """Mass [kg], centre of mass [m] and inertia tensor about it [kg m^2] of the solid a closed,
     outward-oriented triangle surface encloses, of uniform ``density`` [kg/m^3] (trimesh)."""
+    import trimesh  # here, not at import (start-up)
+
     mesh = trimesh.Trimesh(vertices, faces, process=False)
     mesh.density = density
     return float(mesh.mass), np.asarray(mesh.center_mass), np.asarray(mesh.moment_inertia)

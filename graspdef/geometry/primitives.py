@@ -12,7 +12,6 @@ import operator
 from collections.abc import Callable
 
 import numpy as np
-import trimesh
 
 from graspdef.errors import ProblemError
 from graspdef.geometry.mesh import TriMesh
@@ -178,6 +177,8 @@ def icosphere(radius: float, subdivisions: int) -> TriMesh:
     """
     radius = _positive(radius, "radius")
     subdivisions = _count(subdivisions, "subdivisions", 0)
+    import trimesh.creation  # here, not at import (start-up: the other primitives need no trimesh)
+
     ico = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
     v = np.array(ico.vertices, dtype=np.float64)
     v *= radius / np.linalg.norm(v, axis=1, keepdims=True)

@@ -4,7 +4,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ..errors import ProblemError
 from ..shell.model import Shell
@@ -46,6 +45,8 @@ def locate(shell: Shell, ev: SurfaceEvaluator | None, point, name: str = "point"
     real = shell.mesh.faces[: shell.mesh.n_real_faces]
     cent = x[real].mean(axis=1)
     k = min(n_candidates, len(real))
+    from scipy.spatial import cKDTree  # here, not at import (start-up: scipy.spatial pulls scipy.special)
+
     _, cand = cKDTree(cent).query(p, k=k)
     face, bary, dist = project_point(ev, x, p, np.atleast_1d(cand))
     if tol is None:

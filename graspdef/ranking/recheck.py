@@ -21,7 +21,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy.stats import spearmanr
 
 from ..errors import GraspdefError
 from ..objects import scene_xml
@@ -85,6 +84,8 @@ def recheck_top(scene, spec, rows: list[dict], progress=None) -> dict:
             out.append(entry)
         say("recheck", {"done": len(rows), "of": len(rows)})
     ok = [e for e in out if e["nonlinear_closing_m"] is not None]
+    from scipy.stats import spearmanr  # here, not at import (scipy.stats takes ~0.5 s)
+
     rho = (float(spearmanr([e["linear_closing_m"] for e in ok], [e["nonlinear_closing_m"] for e in ok]).statistic)
            if len(ok) >= 3 else math.nan)
     return {"recheck": out, "recheck_spearman": rho,

@@ -26,7 +26,6 @@ from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
-import trimesh
 
 from ..units import LENGTH_UNITS
 from .derived import displacement_field_label
@@ -51,6 +50,8 @@ def unit_scale(unit: str | None) -> float:
 
 def _ply(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, str | None]:
     """Vertices (file units), faces (or (0, 3)), the raw vertex record array and the units comment."""
+    import trimesh  # here, not at import (start-up)
+
     try:
         m = trimesh.load(path, process=False)
     except Exception as exc:  # trimesh raises many types for unreadable files
