@@ -43,11 +43,11 @@ _GEOMETRY = {
     "hemisphere": {"radius", "n_rings", "hole_angle_deg"},
     "monkey_saddle": {"half_width", "n", "scale"},
     "annulus": {"r_inner", "r_outer", "n_theta", "n_r", "slit_deg"},
-    "polygon": {"outer", "holes", "edge_length"},
+    "polygon": {"outer", "holes", "edge_length", "refinements"},
     "mesh": {"path", "units"},
 }
-_GEOMETRY_OPTIONAL = {"center", "theta0_deg", "theta1_deg", "hole_angle_deg", "scale", "units", "slit_deg", "holes"}
-_INTEGER_KEYS = {"nx", "ny", "n", "n_theta", "n_z", "n_rings", "subdivisions", "n_r"}
+_GEOMETRY_OPTIONAL = {"center", "theta0_deg", "theta1_deg", "hole_angle_deg", "scale", "units", "slit_deg", "holes", "refinements"}
+_INTEGER_KEYS = {"nx", "ny", "n", "n_theta", "n_z", "n_rings", "subdivisions", "n_r", "refinements"}
 #: [solver] keys and their kinds ("length" values are converted from the file's length unit)
 _SOLVER = {"backend": "str", "collocation": "int", "type": "str", "method": "str", "steps": "int",
            "max_load": "float", "targets": "list", "max_steps": "int", "max_iterations": "int", "tol": "float",
