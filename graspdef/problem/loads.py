@@ -103,7 +103,7 @@ class EdgeLoad:
             raise ProblemError(f"edge load '{self.name}': the surface has no boundary edges")
         mask = boundary_edge_mask(shell, self.where, self.side)
         if not mask.any():
-            raise ProblemError(f"edge load '{self.name}': its region selects no boundary edge")
+            raise ProblemError(f"edge load '{self.name}': its region{'' if self.side is None else ' and side'} select{'s' if self.side is None else ''} no boundary edge")
         t_gl, w_gl = np.polynomial.legendre.leggauss(self.n_points)
         taus, wts = 0.5 * (t_gl + 1.0), 0.5 * w_gl
         corners = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])

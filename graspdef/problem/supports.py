@@ -205,7 +205,8 @@ def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: i
                 raise SupportError(f"support '{sup.name}': the surface has no boundary edges")
             mask = boundary_edge_mask(shell, sup.where, sup.side)
             if not mask.any():
-                raise SupportError(f"support '{sup.name}' ({sup.kind}): its region selects no boundary edge")
+                raise SupportError(f"support '{sup.name}' ({sup.kind}): "
+                                   f"its region{'' if sup.side is None else ' and side'} select{'s' if sup.side is None else ''} no boundary edge")
             any_edge = True
             edges = np.flatnonzero(mask)
             faces = mesh.boundary_faces[edges]
