@@ -13,12 +13,14 @@ from graspdef.geometry.mesh import (
     vertex_valence,
 )
 from graspdef.geometry.primitives import (
+    annulus,
     cylinder,
     ellipsoid,
     height_field,
     hemisphere,
     icosphere,
     monkey_saddle,
+    polygon,
     rectangle,
     sphere,
     square_plate,
@@ -26,8 +28,8 @@ from graspdef.geometry.primitives import (
 from graspdef.geometry.regions import compile_predicate
 
 __all__ = [
-    "LENGTH_UNITS", "TriMesh", "boundary_edges", "boundary_loops", "compile_predicate",
+    "LENGTH_UNITS", "TriMesh", "annulus", "boundary_edges", "boundary_loops", "compile_predicate",
     "cylinder", "edge_face_counts", "ellipsoid", "height_field", "hemisphere", "icosphere",
-    "is_closed", "length_scale", "load_mesh", "monkey_saddle", "rectangle", "save_ply", "sphere",
+    "is_closed", "length_scale", "load_mesh", "monkey_saddle", "polygon", "rectangle", "save_ply", "sphere",
     "square_plate", "unique_edges", "validate_mesh", "vertex_valence",
 ]

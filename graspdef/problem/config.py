@@ -26,6 +26,7 @@ from ..shell.hyperelastic import MATERIALS, PARAMETERS, make_material
 from ..shell.memory import check_memory
 from ..shell.model import Shell
 from ..units import FORCE_UNITS  # noqa: F401  (re-exported: the unit tables live in graspdef.units)
+from .edges import face_centroids
 from .loads import BodyForce, EdgeLoad, PointLoad, Pressure
 from .potentials import EdgeMoment, EnclosedGas, FollowerPressure
 from .problem import BACKENDS, Problem, SurfacePoint, locate
@@ -41,28 +42,32 @@ _GEOMETRY = {
     "ellipsoid": {"a", "b", "c", "subdivisions"},
     "hemisphere": {"radius", "n_rings", "hole_angle_deg"},
     "monkey_saddle": {"half_width", "n", "scale"},
+    "annulus": {"r_inner", "r_outer", "n_theta", "n_r", "slit_deg"},
+    "polygon": {"outer", "holes", "edge_length", "refinements"},
     "mesh": {"path", "units"},
 }
-_GEOMETRY_OPTIONAL = {"center", "theta0_deg", "theta1_deg", "hole_angle_deg", "scale", "units"}
-_INTEGER_KEYS = {"nx", "ny", "n", "n_theta", "n_z", "n_rings", "subdivisions"}
+_GEOMETRY_OPTIONAL = {"center", "theta0_deg", "theta1_deg", "hole_angle_deg", "scale", "units", "slit_deg", "holes", "refinements"}
+_INTEGER_KEYS = {"nx", "ny", "n", "n_theta", "n_z", "n_rings", "subdivisions", "n_r", "refinements"}
 #: [solver] keys and their kinds ("length" values are converted from the file's length unit)
 _SOLVER = {"backend": "str", "collocation": "int", "type": "str", "method": "str", "steps": "int",
            "max_load": "float", "targets": "list", "max_steps": "int", "max_iterations": "int", "tol": "float",
            "min_step": "float", "desired_iterations": "int", "max_growth": "float", "line_search": "bool",
            "max_probe_displacement": "length", "refine_critical": "int",
            "reuse_factorisation": "bool", "reuse_ratio": "float", "anderson": "int", "inertia_rtol": "float"}
-_LENGTH_KEYS = {"lx", "ly", "center", "a", "b", "c", "radius", "length", "half_width", "scale"}
+_LENGTH_KEYS = {"lx", "ly", "center", "a", "b", "c", "radius", "length", "half_width", "scale", "r_inner", "r_outer",
+                "edge_length"}
 _REFERENCE = {"value", "quantity", "tolerance", "source", "formula", "load_factors", "values", "curve",
               "curve_params", "compare", "abscissa", "abscissa_scale", "range_normalised"}
 _SUPPORT_KEYS = {"rigid_modes": ({"kind", "name"}, ()),
-                 "point": ({"kind", "name", "at", "face", "bary", "directions", "tolerance", "displacement"}, ())}
-_LOAD_KEYS = {"point": ({"kind", "at", "face", "bary", "force", "tolerance"}, ("force",)),
+                 "point": ({"kind", "name", "at", "face", "bary", "directions", "tolerance", "displacement", "side"},
+                           ())}
+_LOAD_KEYS = {"point": ({"kind", "at", "face", "bary", "force", "tolerance", "side"}, ("force",)),
               "pressure": ({"kind", "p", "region"}, ("p",)),
               "gravity": ({"kind", "density", "g"}, ("density", "g")),
               "follower_pressure": ({"kind", "p"}, ("p",)),
               "gas": ({"kind", "p0", "p_atm"}, ("p0",)),
-              "edge_load": ({"kind", "region", "force", "name"}, ("region", "force")),
-              "edge_moment": ({"kind", "region", "moment", "axis", "name"}, ("region", "moment", "axis"))}
+              "edge_load": ({"kind", "region", "force", "name", "side"}, ("region", "force")),
+              "edge_moment": ({"kind", "region", "moment", "axis", "name", "side"}, ("region", "moment", "axis"))}
 
 
 @dataclass
@@ -143,6 +148,13 @@ def _geometry(g: Table, units: FileUnits, base: Path):
             continue
         if k == "center":
             args[k] = tuple(np.array(g.vector(k, 2)) * ls)
+        elif k == "outer":
+            args[k] = _points(g, k, g[k]) * ls
+        elif k == "holes":
+            holes = g[k]
+            if not isinstance(holes, list):
+                raise g.error(f"must be a list of polygons (lists of [x, y] points), got {holes!r}", k)
+            args[k] = [_points(g, k, h, f" hole {i + 1}") * ls for i, h in enumerate(holes)]
         elif k.endswith("_deg"):
             args[k[:-4]] = math.radians(g.number(k))
         elif k in _INTEGER_KEYS:
@@ -162,7 +174,21 @@ def _geometry(g: Table, units: FileUnits, base: Path):
         return prim.height_field(lambda x, y: (x ** 3 - 3 * x * y ** 2) / scale, (-hw, hw), (-hw, hw), args["n"], args["n"])
     if kind == "sphere":
         return prim.icosphere(**args)
-    return getattr(prim, kind)(**args)
+    try:
+        return getattr(prim, kind)(**args)
+    except ProblemError as exc:
+        raise g.error(str(exc)) from None
+
+
+def _points(g: Table, key: str, value, what: str = "") -> np.ndarray:
+    """A polygon's points (n, 2) as written in the file (finite numbers, file units)."""
+    if (not isinstance(value, list) or len(value) < 3
+            or not all(isinstance(p, list) and len(p) == 2 for p in value)
+            or not all(isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c)
+                       for p in value for c in p)):
+        raise g.error(f"{what} must be a list of at least 3 [x, y] points of finite numbers, "
+                      f"got {value!r}".lstrip(), key)
+    return np.array(value, dtype=float)
 
 
 def _vertex_count(kind: str, args: dict) -> int | None:
@@ -175,6 +201,8 @@ def _vertex_count(kind: str, args: dict) -> int | None:
         return (args["n"] + 1) ** 2
     if kind == "cylinder":
         return (args["n_theta"] + 1) * (args["n_z"] + 1)
+    if kind == "annulus":
+        return (args["n_theta"] + 1) * (args["n_r"] + 1)
     return None
 
 
@@ -256,10 +284,16 @@ def load_problem(path: str | Path) -> ProblemSpec:
 
     ev = shell.evaluator
 
+    def side(entry: Table):
+        """The optional ``side`` region (evaluated at face centroids: one lip of a slit)."""
+        return preds[entry.string("side", choices=preds)] if "side" in entry else None
+
     def surface_point(entry: Table, label: str) -> SurfacePoint:
         if ("at" in entry) == ("face" in entry):
             raise entry.error("give either 'at' (a position) or 'face' and 'bary'")
         if "face" in entry:
+            if "side" in entry:
+                raise entry.error("'side' only applies with 'at' (a position)")
             face = entry.integer("face")
             bary = np.array(entry.vector("bary"))
             if not (0 <= face < len(shell.faces)):
@@ -269,8 +303,9 @@ def load_problem(path: str | Path) -> ProblemSpec:
             return SurfacePoint(face, tuple(float(b) for b in bary))
         at = np.array(entry.vector("at")) * ls
         tol = units.quantity(entry, "tolerance", "length", None)
+        on = side(entry)
         try:
-            return locate(shell, ev, at, label, tol)[0]
+            return locate(shell, ev, at, label, tol, faces=None if on is None else on(face_centroids(shell)))[0]
         except ProblemError as exc:
             raise entry.error(str(exc)) from None
 
@@ -292,11 +327,11 @@ def load_problem(path: str | Path) -> ProblemSpec:
             except ProblemError as exc:
                 raise s.error(str(exc)) from None
         else:
-            s.check({"kind", "name", "region", "normal"}, ("region",))
+            s.check({"kind", "name", "region", "normal", "side"}, ("region",))
             reg = s.string("region", choices=preds)
             normal = s.vector("normal", 3, None)
             try:
-                supports.append(EdgeSupport(kind, preds[reg], normal, s.string("name", reg)))
+                supports.append(EdgeSupport(kind, preds[reg], normal, s.string("name", reg), side(s)))
             except ProblemError as exc:
                 raise s.error(str(exc)) from None
 
@@ -326,13 +361,15 @@ def load_problem(path: str | Path) -> ProblemSpec:
             region = ld.string("region", choices=preds)
             name = ld.string("name", region)
             if kind == "edge_load":             # force per unit length
-                loads.append(EdgeLoad(preds[region], tuple(np.array(ld.vector("force")) * fs / ls), name))
+                loads.append(EdgeLoad(preds[region], tuple(np.array(ld.vector("force")) * fs / ls), name,
+                                      side=side(ld)))
             else:                               # moment per unit length = force
-                loads.append(EdgeMoment(preds[region], ld.number("moment") * fs, ld.vector("axis"), name))
+                loads.append(EdgeMoment(preds[region], ld.number("moment") * fs, ld.vector("axis"), name,
+                                        side=side(ld)))
 
     probes = {}
     for pr in doc.tables("probes"):
-        pr.check({"name", "at", "face", "bary", "tolerance"}, ("name",))
+        pr.check({"name", "at", "face", "bary", "tolerance", "side"}, ("name",))
         name = pr.string("name")
         if name in probes:
             raise pr.error(f"duplicate probe name {name!r}")

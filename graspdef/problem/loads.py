@@ -13,6 +13,7 @@ import numpy as np
 from ..errors import ProblemError
 from ..shell.model import Shell, surface_derivatives
 from ..subdivision.evaluate import SurfaceEvaluator
+from .edges import boundary_edge_mask
 
 
 def _finite_vector(name: str, v, n: int = 3) -> np.ndarray:
@@ -83,13 +84,16 @@ class BodyForce:
 @dataclass(frozen=True)
 class EdgeLoad:
     """Dead line load ``force`` [N/m] (per unit rest length) on the boundary edges whose two end
-    vertices satisfy ``where`` (callable (n, 3) -> (n,) bool on rest positions [m]); integrated
-    along the limit boundary curve with ``n_points`` Gauss points per edge."""
+    vertices satisfy ``where`` (callable (n, 3) -> (n,) bool on rest positions [m]) and, if ``side``
+    is given, whose owning face's centroid satisfies ``side`` (one lip of a slit;
+    ``graspdef.problem.edges``); integrated along the limit boundary curve with ``n_points``
+    Gauss points per edge."""
 
     where: object
     force: tuple[float, float, float]
     name: str = "edge_load"
     n_points: int = 3
+    side: object = None
 
     def vector(self, shell: Shell, ev: SurfaceEvaluator) -> np.ndarray:
         F = _finite_vector(f"edge load '{self.name}' force", self.force)
@@ -97,10 +101,9 @@ class EdgeLoad:
         ab = mesh.boundary_edges
         if len(ab) == 0:
             raise ProblemError(f"edge load '{self.name}': the surface has no boundary edges")
-        xv = np.asarray(shell.vertices, float)
-        mask = np.asarray(self.where(xv[ab[:, 0]]), bool) & np.asarray(self.where(xv[ab[:, 1]]), bool)
+        mask = boundary_edge_mask(shell, self.where, self.side)
         if not mask.any():
-            raise ProblemError(f"edge load '{self.name}': its region selects no boundary edge")
+            raise ProblemError(f"edge load '{self.name}': its region{'' if self.side is None else ' and side'} select{'s' if self.side is None else ''} no boundary edge")
         t_gl, w_gl = np.polynomial.legendre.leggauss(self.n_points)
         taus, wts = 0.5 * (t_gl + 1.0), 0.5 * w_gl
         corners = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])

@@ -33,6 +33,7 @@ import scipy.sparse as sp
 from ..shell.kinematics import fundamental_forms, normal, strain_hessian_contract, strain_jacobian, strains
 from ..shell.model import Shell
 from ..subdivision.evaluate import SurfaceEvaluator
+from .edges import boundary_edge_mask
 from .supports import EdgeSupport
 
 _CORNERS = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
@@ -45,7 +46,6 @@ class NitscheRotation:
         self.shell = shell
         mesh = shell.mesh
         X = shell.rest_positions
-        xv = np.asarray(shell.vertices, float)
         mat = shell.material
         thick = np.broadcast_to(np.asarray(shell.thickness, float), (mesh.n_real_faces,))
         t_gl, w_gl = np.polynomial.legendre.leggauss(n_points)
@@ -58,7 +58,7 @@ class NitscheRotation:
             dirs, _ = sup.directions()
             plane = dirs[0] if sup.kind == "symmetry" else np.zeros(3)
             ab = mesh.boundary_edges
-            mask = np.asarray(sup.where(xv[ab[:, 0]]), bool) & np.asarray(sup.where(xv[ab[:, 1]]), bool)
+            mask = boundary_edge_mask(shell, sup.where, sup.side)
             for e in np.flatnonzero(mask):
                 a, b = ab[e]
                 f = int(mesh.boundary_faces[e])

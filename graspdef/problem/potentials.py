@@ -31,6 +31,7 @@ from ..errors import ProblemError
 from ..shell.model import Shell
 from ..shell.volume import EnclosedVolume
 from ..subdivision.evaluate import SurfaceEvaluator
+from .edges import boundary_edge_mask
 from .terms import TermBase, TermValue
 
 #: standard atmosphere [Pa]
@@ -160,6 +161,7 @@ class EdgeMoment(TermBase):
     axis: tuple[float, float, float]
     name: str = "edge_moment"
     n_points: int = 3
+    side: Callable[[np.ndarray], np.ndarray] | None = None     # one lip of a slit (problem.edges)
 
     def build(self, shell: Shell, ev: SurfaceEvaluator) -> "EdgeMoment":
         """A ready term of this specification on ``shell`` (a new object; this one is unchanged)."""
@@ -176,10 +178,9 @@ class EdgeMoment(TermBase):
         ab = mesh.boundary_edges
         if len(ab) == 0:
             raise ProblemError(f"edge moment '{self.name}': the surface has no boundary edges")
-        xv = np.asarray(shell.vertices, float)
-        mask = np.asarray(self.where(xv[ab[:, 0]]), bool) & np.asarray(self.where(xv[ab[:, 1]]), bool)
+        mask = boundary_edge_mask(shell, self.where, self.side)
         if not mask.any():
-            raise ProblemError(f"edge moment '{self.name}': its region selects no boundary edge")
+            raise ProblemError(f"edge moment '{self.name}': its region{'' if self.side is None else ' and side'} select{'s' if self.side is None else ''} no boundary edge")
         t_gl, w_gl = np.polynomial.legendre.leggauss(self.n_points)
         taus, wts = 0.5 * (t_gl + 1.0), 0.5 * w_gl
         X = shell.rest_positions

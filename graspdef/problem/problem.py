@@ -32,8 +32,9 @@ class SurfacePoint:
 
 
 def locate(shell: Shell, ev: SurfaceEvaluator | None, point, name: str = "point", tol: float | None = None,
-           n_candidates: int = 8) -> tuple[SurfacePoint, float]:
-    """Closest limit-surface point to ``point`` [m].
+           n_candidates: int = 8, faces: np.ndarray | None = None) -> tuple[SurfacePoint, float]:
+    """Closest limit-surface point to ``point`` [m], on the real faces where the boolean mask
+    ``faces`` is true if it is given (one lip of a slit: ``graspdef.problem.edges``).
 
     Raises ProblemError when it is farther than ``tol`` (default: half the mean edge length of
     the control mesh) -- a probe or load off the surface."""
@@ -43,11 +44,17 @@ def locate(shell: Shell, ev: SurfaceEvaluator | None, point, name: str = "point"
         raise ProblemError(f"{name}: position must be three finite numbers, got {point!r}")
     x = shell.rest_positions
     real = shell.mesh.faces[: shell.mesh.n_real_faces]
-    cent = x[real].mean(axis=1)
-    k = min(n_candidates, len(real))
+    allowed = np.arange(len(real))
+    if faces is not None:
+        allowed = np.flatnonzero(np.asarray(faces, bool))
+        if len(allowed) == 0:
+            raise ProblemError(f"{name}: its side region selects no face")
+    cent = x[real[allowed]].mean(axis=1)
+    k = min(n_candidates, len(allowed))
     from scipy.spatial import cKDTree  # here, not at import (start-up: scipy.spatial pulls scipy.special)
 
     _, cand = cKDTree(cent).query(p, k=k)
+    cand = allowed[np.atleast_1d(cand)]
     face, bary, dist = project_point(ev, x, p, np.atleast_1d(cand))
     if tol is None:
         e = x[real[:, [1, 2, 0]]] - x[real]

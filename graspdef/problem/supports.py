@@ -39,6 +39,7 @@ from ..errors import ProblemError, SupportError
 from ..shell.model import Shell
 from ..subdivision.evaluate import SurfaceEvaluator
 from ..subdivision.patch import regular_basis
+from .edges import boundary_edge_mask
 
 KINDS = ("free", "simply_supported", "clamped", "symmetry", "diaphragm")
 
@@ -60,12 +61,15 @@ class EdgeSupport:
     where : callable (n, 3) -> (n,) bool, evaluated on rest vertex positions [m]
     normal : plane normal (symmetry) or diaphragm-plane normal (diaphragm)
     name : label used in messages
+    side : callable, optional: keeps only the edges whose owning face's centroid satisfies it
+        (one lip of a slit; ``graspdef.problem.edges``)
     """
 
     kind: str
     where: Callable[[np.ndarray], np.ndarray]
     normal: tuple[float, float, float] | None = None
     name: str = "support"
+    side: Callable[[np.ndarray], np.ndarray] | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
@@ -190,7 +194,6 @@ def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: i
     Returns (C csr, labels: one string per row naming the support and edge) and, with
     ``with_targets``, the prescribed values g (m,) [m] of C u = g at load factor 1."""
     x = shell.rest_positions
-    xv = np.asarray(shell.vertices, dtype=float)          # the given geometry, for region predicates
     n = shell.n_control
     rows, cols, vals, labels = [], [], [], []
     targets: dict[int, float] = {}
@@ -213,9 +216,10 @@ def constraint_rows(shell: Shell, supports: list, ev: SurfaceEvaluator, n_col: i
             ab = mesh.boundary_edges
             if len(ab) == 0:
                 raise SupportError(f"support '{sup.name}': the surface has no boundary edges")
-            mask = np.asarray(sup.where(xv[ab[:, 0]]), bool) & np.asarray(sup.where(xv[ab[:, 1]]), bool)
+            mask = boundary_edge_mask(shell, sup.where, sup.side)
             if not mask.any():
-                raise SupportError(f"support '{sup.name}' ({sup.kind}): its region selects no boundary edge")
+                raise SupportError(f"support '{sup.name}' ({sup.kind}): "
+                                   f"its region{'' if sup.side is None else ' and side'} select{'s' if sup.side is None else ''} no boundary edge")
             any_edge = True
             edges = np.flatnonzero(mask)
             faces = mesh.boundary_faces[edges]
