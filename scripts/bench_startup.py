@@ -9,7 +9,8 @@ for the OLD code (a git ref, default ``main``, checked out with ``git worktree a
 folder) and the NEW code (this working tree), with the same Python, each tree on ``PYTHONPATH`` and
 as the working directory.  Each case runs once untimed first (numba's on-disk cache is compiled
 there: ~20 s for a fresh checkout), then ``--repeats`` times, OLD and NEW alternating so that the
-load of a shared machine falls on both; medians are reported.  Both trees are byte-compiled first
+load of a shared machine falls on both; medians are reported, with the least wall time and the median CPU time (user + system of all
+the process's threads: less sensitive to other work than the wall clock).  Both trees are byte-compiled first
 (``compileall``), as an installed package is, unless ``--no-compile``: with PYTHONDONTWRITEBYTECODE
 set, graspdef's own modules would otherwise be compiled from source in every process (~0.1 s).
 
@@ -29,6 +30,7 @@ import argparse
 import datetime
 import json
 import os
+import resource
 import shutil
 import statistics
 import subprocess
@@ -54,15 +56,20 @@ def cases(out: Path) -> dict[str, list[str]]:
             "plate solve (1,681 control vertices)": ["-c", CLI, "-q", "solve", PLATE, "--out", str(out / "plate")]}
 
 
-def run(python: str, tree: Path, args: list[str], extra: tuple[str, ...] = ()) -> tuple[float, subprocess.CompletedProcess]:
-    """Wall time [s] of one whole process ``python *extra *args`` run in ``tree``."""
+def run(python: str, tree: Path, args: list[str],
+        extra: tuple[str, ...] = ()) -> tuple[float, float, subprocess.CompletedProcess]:
+    """Wall time and CPU time (user + system, all its threads) [s] of one whole process
+    ``python *extra *args`` run in ``tree``."""
     env = dict(os.environ, PYTHONPATH=str(tree))
+    c0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     r = subprocess.run([python, *extra, *args], cwd=tree, env=env, capture_output=True, text=True, check=False)
     dt = time.perf_counter() - t0
+    c1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (c1.ru_utime - c0.ru_utime) + (c1.ru_stime - c0.ru_stime)
     if r.returncode != 0:
         raise SystemExit(f"bench_startup: {' '.join(args[:1] + args[2:])} failed in {tree}:\n{r.stderr[-2000:]}")
-    return dt, r
+    return dt, cpu, r
 
 
 def import_times(stderr: str) -> list[tuple[int, int, int, str]]:
@@ -120,25 +127,29 @@ def main() -> None:
             if not a.no_compile:
                 subprocess.run([python, "-m", "compileall", "-q", str(tree / "graspdef")], check=True,
                                capture_output=True)
-            _, r = run(python, tree, ["-c", "import graspdef; print(graspdef.__file__)"])
+            *_, r = run(python, tree, ["-c", "import graspdef; print(graspdef.__file__)"])
             assert Path(r.stdout.strip()).is_relative_to(tree), (k, r.stdout)       # the tree, not an install
         results = {}
         for case in cases(tmp):
             print(f"{case}: warm-up, then {a.repeats} runs of each tree ...", file=sys.stderr, flush=True)
             times: dict[str, list[float]] = {"old": [], "new": []}
+            cpu: dict[str, list[float]] = {"old": [], "new": []}
             imports = {}
             for k, tree in trees.items():
                 run(python, tree, cases(outs[k])[case])                         # warm-up (numba cache, OS cache)
             for _ in range(a.repeats):
                 for k, tree in trees.items():
-                    times[k].append(run(python, tree, cases(outs[k])[case])[0])
+                    dt, c, _ = run(python, tree, cases(outs[k])[case])
+                    times[k].append(dt)
+                    cpu[k].append(c)
             for k, tree in trees.items():          # the run of least total import time (noise only adds)
                 runs = [import_summary(import_times(run(python, tree, cases(outs[k])[case],
-                                                        extra=("-X", "importtime"))[1].stderr), a.top)
+                                                        extra=("-X", "importtime"))[2].stderr), a.top)
                         for _ in range(a.importtime_repeats)]
                 imports[k] = min(runs, key=lambda x: x["total_ms"])
                 imports[k]["totals_ms"] = [x["total_ms"] for x in runs]
             results[case] = {k: {"runs_s": times[k], "median_s": statistics.median(times[k]), "min_s": min(times[k]),
+                                 "cpu_runs_s": cpu[k], "cpu_median_s": statistics.median(cpu[k]),
                                  "import_time": imports[k]} for k in trees}
         plate = {}
         for k in trees:
@@ -158,12 +169,14 @@ def main() -> None:
     print(f"\nOLD = {a.ref} ({old_commit[:10]}), NEW = working tree ({git('rev-parse', 'HEAD')[:10]}"
           f"{', with changes' if git('status', '--porcelain', '--untracked-files=no', '--', 'graspdef') else ''}); "
           f"median (least) of {a.repeats} whole processes; imports: the sum of all -X importtime lines (least of {a.importtime_repeats} runs) and the number of modules\n")
-    print("| case | OLD [s] | NEW [s] | OLD / NEW | OLD imports [ms] (modules) | NEW imports [ms] (modules) |")
-    print("|---|---|---|---|---|---|")
+    print("| case | OLD [s] | NEW [s] | OLD / NEW | CPU OLD / NEW [s] | OLD imports [ms] (modules) | "
+          "NEW imports [ms] (modules) |")
+    print("|---|---|---|---|---|---|---|")
     for case, r in results.items():
         o, n = r["old"], r["new"]
         print(f"| {case} | {o['median_s']:.3f} ({o['min_s']:.3f}) | {n['median_s']:.3f} ({n['min_s']:.3f}) | "
-              f"{o['median_s'] / n['median_s']:.2f} | {o['import_time']['total_ms']:.0f} ({o['import_time']['modules']}) | "
+              f"{o['median_s'] / n['median_s']:.2f} | {o['cpu_median_s']:.3f} / {n['cpu_median_s']:.3f} | "
+              f"{o['import_time']['total_ms']:.0f} ({o['import_time']['modules']}) | "
               f"{n['import_time']['total_ms']:.0f} ({n['import_time']['modules']}) |")
     print(f"\nplate ({plate['new']['n_control']} control vertices): OLD and NEW centre deflection and largest "
           f"displacement {'equal' if same else 'DIFFER'} to {plate['max_rel_difference']:.1e} of it "
