@@ -222,3 +222,28 @@ def test_stick_slip_threshold(shell, ratio):
         assert carried == pytest.approx(cap, rel=0.03)
         assert sum(r["tangential_force_N"] for r in fr.values()) == pytest.approx(cap, rel=0.03)
         assert all(r["n_slip"] > r["n_stick"] for r in fr.values())
+
+
+@pytest.mark.parametrize("mu, held", [(0.5, False), (0.0, False), (3.0, True)])
+def test_soda_can_held_or_slips_out_in_mujoco(mu, held):
+    """The issue's acceptance case, what "slips out at 0.76 N" means: the 349 g can (weight
+    3.42 N) in the pin gripper at 0.76 N per finger is held by friction only in MuJoCo's settle
+    step (graspdef.sim.grasp: gravity ramped in, the object free); two contacts carry at most
+    mu x 2 x 0.76 N, so it needs mu >= 2.25.  With mu = 0.5 (0.76 N of friction) and mu = 0 it
+    slips out (SimError, one line); with mu = 3 (one value on both sides: fingertip and object
+    geoms) it is held and the fingers' friction carries the weight."""
+    pytest.importorskip("mujoco")
+    from graspdef.sim.grasp import grasp
+    from graspdef.sim.scene import SimError
+
+    if not held:
+        with pytest.raises(SimError, match="slipped out"):
+            grasp("scenes/soda_can/scene.xml", 0.76, "soda_can", friction=mu)
+        return
+    g = grasp("scenes/soda_can/scene.xml", 0.76, "soda_can", friction=mu)
+    pf = g.per_finger()
+    assert all(pf[s]["friction_coefficient"] == pytest.approx(mu) for s in ("left", "right"))
+    weight = g.object_mass * np.linalg.norm(g.gravity)
+    assert weight == pytest.approx(0.349 * 9.81, rel=1e-3)
+    assert sum(pf[s]["friction_force"] for s in ("left", "right")) == pytest.approx(weight, rel=0.05)
+    assert sum(pf[s]["friction_force"] for s in ("left", "right")) <= mu * sum(pf[s]["normal_force"] for s in pf) * 1.01
