@@ -26,7 +26,7 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--friction", type=float, metavar="MU",
                     help="Coulomb friction coefficient of fingertips and object, one value for both sides: MuJoCo's "
                          "contacts and, with --contact geometric, the fingertips' friction on the shell (0: "
-                         "frictionless shell side); default: the scene's (MuJoCo's mix of the finger's and the "
+                         "frictionless on both sides: a free object then slips out of MuJoCo's grasp); default: the scene's (MuJoCo's mix of the finger's and the "
                          "object's geom friction, the larger)")
     ap.add_argument("--gas", choices=["auto", "on", "off"], default="auto",
                     help="enclosed air: auto = object.toml's [gas] (nonlinear only), on (object.toml's [gas] p0; "
