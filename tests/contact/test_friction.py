@@ -166,7 +166,8 @@ def _pinch_and_pull(shell, N, mu, pull, k, steps=5):
     of total ``pull``; held along y only by friction and a weak spring k on the mean y
     displacement, in the other five rigid modes by RigidModes' rows (mean x: the pads' common
     advance that force control leaves free; mean z and the three rotations: zero reactions by
-    symmetry).  Returns (mean y displacement [m], the final point's friction records)."""
+    symmetry).  Returns (mean y displacement [m], the final point's records, the number of load
+    steps)."""
     from graspdef.problem.loads import BodyForce
     from graspdef.solve.nonlinear import PathSolver
 
@@ -189,7 +190,7 @@ def _pinch_and_pull(shell, N, mu, pull, k, steps=5):
                      terms=pr.energy_terms() + [spring]).run()
     assert sol.completed, sol.stop_reason
     x = shell.rest_positions + sol.u
-    return spring.mean(x), sol.path[-1].extra
+    return spring.mean(x), sol.path[-1].extra, len(sol.path) - 1
 
 
 @pytest.mark.parametrize("ratio", [0.8, 1.2])
@@ -209,12 +210,12 @@ def test_stick_slip_threshold(shell, ratio):
     N, mu, k = 0.5, 0.5, 40.0
     cap = mu * 2 * N
     t0 = time.perf_counter()
-    ub, ex = _pinch_and_pull(shell, N, mu, ratio * cap, k)
+    ub, ex, n_steps = _pinch_and_pull(shell, N, mu, ratio * cap, k)
     fr = {s: {key.split("_", 3)[-1]: v for key, v in ex.items() if key.startswith(f"friction_{s}_0_")}
           for s in ("left", "right")}
     carried = ratio * cap - k * ub
     print(f"ratio {ratio}: mean y displacement {ub * 1e3:.4f} mm, friction carries {carried:.4f} N "
-          f"= {carried / cap:.4f} mu 2N; records {fr}; {time.perf_counter() - t0:.1f} s")
+          f"= {carried / cap:.4f} mu 2N; {n_steps} load steps; records {fr}; {time.perf_counter() - t0:.1f} s")
     if ratio < 1:
         assert abs(ub) < 2e-4 and k * abs(ub) < 0.02 * ratio * cap
         assert carried == pytest.approx(ratio * cap, rel=0.03)
