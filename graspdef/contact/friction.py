@@ -164,7 +164,7 @@ class FingerFriction(TermBase):
         """Active faces, their slips u (F', q, 2), Lam (F', q) and A (F', q, 2, 3)."""
         P, Lam, A = self._lag
         af = np.flatnonzero(np.any(Lam > 0, axis=1))
-        dp = self._points(x)[af] - P[af] if len(af) else np.zeros((0,) + P.shape[1:])
+        dp = np.einsum("fqs,fsd->fqd", self._N[af], x[self._st[af]]) - P[af]
         return af, np.einsum("fqaj,fqj->fqa", A[af], dp), Lam[af], A[af]
 
     # ---- energy-term protocol ----------------------------------------------------------------

@@ -8,6 +8,7 @@ import time
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from graspdef.contact.barrier import FingerContact, RoundedBox
 from graspdef.contact.friction import FingerFriction, mollifier
@@ -15,6 +16,7 @@ from graspdef.errors import ProblemError
 from graspdef.geometry import icosphere
 from graspdef.problem.problem import Problem
 from graspdef.problem.supports import RigidModes
+from graspdef.problem.terms import TermBase, TermValue
 from graspdef.shell.materials import LinearElastic
 from graspdef.shell.model import Shell
 from graspdef.solve.nonlinear import PathOptions, solve_nonlinear
@@ -124,41 +126,27 @@ def test_bad_slip_length():
         FingerFriction(_finger(+1, 1.0, "right"), 0.5, eps_v=0.0)
 
 
-class _WeakSpring:
+class _WeakSpring(TermBase):
     """An energy term (k/2) ubar^2 on the surface-mean displacement ubar along ``d`` (area- and
-    thickness-weighted, as the body force's mass weights); the Hessian k v v^T, held sparse."""
-
-    internal = False
+    thickness-weighted, as the body force's mass weights); its Hessian k v v^T is held as a sparse
+    matrix, not a rank-one part (the base of the KKT factorisation must be regular)."""
 
     def __init__(self, shell, k, d):
         from graspdef.problem.loads import BodyForce
 
         m = BodyForce(1.0, (1.0, 0.0, 0.0)).vector(shell, shell.evaluator)[:, 0]
         self.v = (m[:, None] * np.asarray(d, float)[None] / m.sum()).ravel()
-        self.k, self.X, self.H = float(k), shell.rest_positions.ravel(), None
+        self.k, self.X = float(k), shell.rest_positions.ravel()
+        v = sp.csr_matrix(self.v[None])
+        self.H = (self.k * (v.T @ v)).tocsr()
 
     def mean(self, x):
         return float(self.v @ (x.ravel() - self.X))
 
     def evaluate(self, x, lam, order=2, u=None):
-        from graspdef.problem.terms import TermValue
-
         ub = self.mean(x)
-        import scipy.sparse as sp
-        if order == 2 and self.H is None:        # sparse (the base of the KKT factorisation must be regular)
-            v = sp.csr_matrix(self.v[None])
-            self.H = (self.k * (v.T @ v)).tocsr()
         return TermValue(0.5 * self.k * ub * ub, None if order == 0 else self.k * ub * self.v,
                          self.H if order == 2 else None)
-
-    def load(self, x):
-        return None
-
-    def commit(self, x):
-        pass
-
-    def record(self, x):
-        return {}
 
 
 def _pinch_and_pull(shell, N, mu, pull, k, steps=5):
