@@ -1,4 +1,4 @@
-"""``graspdef grasp SCENE --force F [--contact point|geometric] [--analysis ...] --out DIR``."""
+"""``graspdef grasp SCENE --force F [--contact point|geometric] [--friction MU] [--analysis ...] --out DIR``."""
 from __future__ import annotations
 
 import argparse
@@ -23,6 +23,11 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--tip-material", choices=["rubber", "steel"],
                     help="this run's fingertip material: its friction and contact stiffness "
                          "(the scene's: steel pins, rubber pads)")
+    ap.add_argument("--friction", type=float, metavar="MU",
+                    help="Coulomb friction coefficient of fingertips and object, one value for both sides: MuJoCo's "
+                         "contacts and, with --contact geometric, the fingertips' friction on the shell (0: "
+                         "frictionless on both sides: a free object then slips out of MuJoCo's grasp); default: the scene's (MuJoCo's mix of the finger's and the "
+                         "object's geom friction, the larger)")
     ap.add_argument("--gas", choices=["auto", "on", "off"], default="auto",
                     help="enclosed air: auto = object.toml's [gas] (nonlinear only), on (object.toml's [gas] p0; "
                          "an error if it has none), off")
@@ -96,7 +101,8 @@ def run(a: argparse.Namespace) -> int:
 
         tips = FingertipChange(None if a.pad_size is None else quantity(a.pad_size, "length", what="--pad-size"),
                                a.tip_material)
-    run = run_grasp(scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E, progress=bar, fingertips=tips)
+    run = run_grasp(scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E, progress=bar, fingertips=tips,
+                    friction=getattr(a, "friction", None))
     bar._end()                                           # close an open progress line before the summary
     r = run.result
     d = r["derived"]

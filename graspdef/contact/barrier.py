@@ -270,6 +270,37 @@ class FingerContact(TermBase):
             s += dm
         return s
 
+    # ---- per-sample contact state (for the friction term, graspdef.contact.friction) ----------
+    @property
+    def closing_axis(self) -> np.ndarray:
+        """The unit closing axis e (3,) of the finger (object frame)."""
+        return self._e.copy()
+
+    @property
+    def gap_reach(self) -> float:
+        """The barrier's reach dhat [m] (the default resolved)."""
+        return self._dh
+
+    @property
+    def samples(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The samples: stencils (F, S), basis values N (F, q, S) and rest weights (F, q) [m^2];
+        sample point p_fq = sum_s N[f, q, s] x[stencils[f, s]]."""
+        return self._st, self._N, self._w
+
+    def sample_forces(self, x: np.ndarray, F: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """At control points x (n, 3) with the finger pushed by F [N]: the sample points (F, q, 3)
+        [m], the normal contact force of each sample (F, q) [N] (barrier pressure x rest weight,
+        >= 0; zero for F <= 0) and the fingertip's unit outward normal at each sample's closest
+        point (F, q, 3) (the direction of the force on the shell)."""
+        pts = self._points(x)
+        if F <= 0:
+            d, n = self._phi(pts, 0.0, False)
+            return pts, np.zeros(d.shape), n
+        s = self.advance(x, F)
+        d, n = self._phi(pts, s, False)
+        _, b1, _ = log_barrier(d.ravel(), self._dh)
+        return pts, -self._kappa * b1.reshape(d.shape) * self._w, n
+
     # ---- reporting ---------------------------------------------------------------------------
     def report(self, x: np.ndarray, lam: float, check_level: int = 3) -> dict:
         """Finger advance, contact force (vector and along the axis), contact area (sampled area

@@ -67,6 +67,9 @@ class ContactSet:
     #: (n_contacts, 3) contact torques ON THE OBJECT [N m] (torsional friction about the normal,
     #: condim >= 4), or None
     torques: np.ndarray | None = None
+    #: (n_contacts,) sliding friction coefficient of each contact (MuJoCo's: the larger of the two
+    #: geoms' when their priorities are equal), or None
+    mu: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = len(self.finger)
@@ -89,7 +92,8 @@ class ContactSet:
 
     def per_finger(self) -> dict[str, dict]:
         """Sums per finger: total force vector on the object [N], normal-force sum, friction sum,
-        force-weighted mean contact point and the unit mean normal."""
+        force-weighted mean contact point, the unit mean normal and the friction coefficient (the
+        largest of the finger's contacts'; None if not known)."""
         out = {}
         for f in self.fingers:
             m = self.select(f)
@@ -97,6 +101,7 @@ class ContactSet:
             w = fn / fn.sum() if fn.sum() > 0 else np.full(m.sum(), 1 / m.sum())
             nrm = (self.normals[m] * fn[:, None]).sum(axis=0)
             out[f] = {"n_contacts": int(m.sum()), "force": self.forces[m].sum(axis=0),
+                      "friction_coefficient": None if self.mu is None or not m.any() else float(self.mu[m].max()),
                       "normal_force": float(fn.sum()), "friction_force": float(self.friction_force[m].sum()),
                       "point": w @ self.positions[m], "normal": nrm / max(np.linalg.norm(nrm), 1e-300)}
         return out
@@ -114,11 +119,12 @@ class ContactSet:
         return ContactSet(pose.to_object(self.positions), pose.vector_to_object(self.normals),
                           pose.vector_to_object(self.forces), self.normal_force, self.friction_force,
                           self.finger, self.geoms,
-                          None if self.torques is None else pose.vector_to_object(self.torques))
+                          None if self.torques is None else pose.vector_to_object(self.torques), self.mu)
 
     def records(self) -> list[dict]:
         return [{"finger": self.finger[i], "position_m": self.positions[i].tolist(),
                  "normal": self.normals[i].tolist(), "force_N": self.forces[i].tolist(),
                  "normal_force_N": float(self.normal_force[i]), "friction_force_N": float(self.friction_force[i]),
                  **({"torque_Nm": self.torques[i].tolist()} if self.torques is not None else {}),
+                 **({"friction_coefficient": float(self.mu[i])} if self.mu is not None else {}),
                  **({"geoms": list(self.geoms[i])} if self.geoms else {})} for i in range(len(self))]

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -92,6 +92,7 @@ class ShellSetup:
     probes: dict
     residual_F: np.ndarray
     residual_M: np.ndarray
+    friction: dict = field(default_factory=dict)   # finger -> (mu, source) of the shell-side friction terms
 
 
 @dataclass
@@ -166,18 +167,25 @@ def check_force(scene, force: float, fingertips=None) -> None:
 EQUILIBRIUM_RTOL = 0.01
 
 
-def settle(obj: GraspObject, force: float, settings: GraspSettings = GraspSettings(), fingertips=None) -> Settled:
+def settle(obj: GraspObject, force: float, settings: GraspSettings = GraspSettings(), fingertips=None,
+           friction: float | None = None) -> Settled:
     """Stage 2: close the gripper to ``force`` [N] per finger in MuJoCo and settle (``fingertips``:
-    a per-run graspdef.sim.gripper.FingertipChange: pad size, material)."""
+    a per-run graspdef.sim.gripper.FingertipChange: pad size, material; ``friction``: the sliding
+    friction coefficient of fingertips and object, None: the scene's)."""
     if not np.isfinite(force) or force <= 0:
         raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
     targets = {s: (force if s in obj.spec.fingers else 0.0) for s in ("left", "right")}
-    return Settled(grasp(obj.xml, targets, obj.spec.body, settings, fingertips), targets)
+    return Settled(grasp(obj.xml, targets, obj.spec.body, settings, fingertips, friction), targets)
 
 
-def shell_problem(obj: GraspObject, st: Settled, contact: str = "point") -> ShellSetup:
+def shell_problem(obj: GraspObject, st: Settled, contact: str = "point", friction: float | None = None) -> ShellSetup:
     """Stage 3: the contacts as loads on the shell (point loads, or rigid fingertips), the weight,
-    the enclosed air, the supports and the probes."""
+    the enclosed air, the supports and the probes.
+
+    Geometric contact with a friction coefficient mu > 0 adds each fingertip's Coulomb friction
+    on the shell (graspdef.contact.friction.FingerFriction); mu is ``friction`` (the run's, also
+    given to MuJoCo) or, None, each finger's MuJoCo contacts' (the scene's geom friction, mixed
+    as MuJoCo does: the larger of the fingertip's and the object's)."""
     if contact not in ("point", "geometric"):
         raise ProblemError(f"contact must be 'point' (the paper's point loads) or 'geometric' (rigid fingertips), "
                            f"got {contact!r}")
@@ -186,11 +194,20 @@ def shell_problem(obj: GraspObject, st: Settled, contact: str = "point") -> Shel
     mapping = map_contacts(shell, cs)
     loads = list(mapping.loads)
     fingertips = []
+    mus = {}
     if contact == "geometric":      # fingertips as rigid obstacles; MuJoCo's other force parts stay dead loads
+        from ..contact.friction import FingerFriction, check_mu
         from .geometric import finger_contacts
 
         loads, fingertips = finger_contacts(mapping, g, st.targets, spec.thickness)
-        loads = loads + fingertips
+        pf = g.per_finger()
+        for fc in fingertips:
+            mu = friction if friction is not None else pf.get(fc.name, {}).get("friction_coefficient")
+            source = "--friction" if friction is not None else "scene (MuJoCo's contacts of this finger)"
+            if mu is None:
+                raise ProblemError(f"geometric contact: no friction coefficient for the {fc.name} finger's contacts")
+            mus[fc.name] = (check_mu(mu, f"{fc.name} finger: friction coefficient"), source)
+        loads = loads + fingertips + [FingerFriction(fc, mus[fc.name][0]) for fc in fingertips if mus[fc.name][0] > 0]
     g_obj = g.pose.vector_to_object(g.gravity)
     free = bool(g.info.get("free_object", True))
     if free:
@@ -219,7 +236,7 @@ def shell_problem(obj: GraspObject, st: Settled, contact: str = "point") -> Shel
     # support has to carry; zero up to MuJoCo's settling and the mass discretisation
     fvec = problem.dead_load_vector().reshape(-1, 3)
     return ShellSetup(problem, mapping, fingertips, free, probes, fvec.sum(axis=0),
-                      np.cross(shell.rest_positions, fvec).sum(axis=0))
+                      np.cross(shell.rest_positions, fvec).sum(axis=0), mus)
 
 
 def solve_shell(setup: ShellSetup, analysis: str, steps: int, progress=None) -> Solved:
@@ -304,6 +321,14 @@ def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solve
         # net force of everything acting on the shell (dead loads + contact forces): what the
         # 3-2-1 support carries
         residual_F = residual_F + sum(np.asarray(r.get("contact_force_N", np.zeros(3))) for r in geo.values())
+        last = sol.path[-1].extra if hasattr(sol, "path") else {}
+        for s, (mu, source) in setup.friction.items():
+            pre = f"friction_{s}_0_"
+            fr = {k[len(pre):]: v for k, v in last.items() if k.startswith(pre)}
+            fingers[s]["friction"] = {"mu": mu, "mu_source": source, **fr}
+            if fr:
+                f_vec = np.array([fr["friction_force_x_N"], fr["friction_force_y_N"], fr["friction_force_z_N"]])
+                residual_F = residual_F + f_vec
     reference = "unloaded equilibrium (load factor 0; with air: the inflated shell)" if ref is not None \
         else "rest shape"
     derived = {"max_displacement": D.max_displacement(x_lim, u_def, "m", rigid_motion_removed=free,
@@ -320,6 +345,12 @@ def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solve
         derived["contact_area"] = D.entry(float(sum(r["contact_area_m2"] for r in geo.values())), "m2",
                                           "contact area", "sampled surface area with gap < dhat (pressure > 0), "
                                                           "all fingers")
+    if any("tangential_force_N" in f.get("friction", {}) for f in fingers.values()):
+        derived["friction_force"] = D.entry(
+            {s: f["friction"]["tangential_force_N"] for s, f in fingers.items() if "tangential_force_N" in f.get("friction", {})},
+            "N", "friction force per finger",
+            "shell-side Coulomb friction (geometric contact): |sum of the friction forces of the finger's samples on the "
+            "shell| normal to its closing axis, at the last load step")
     derived["finger_force"] = D.entry({s: f["normal_force_N"] for s, f in fingers.items()}, "N",
                                       "normal force per finger", "MuJoCo's settled normal contact force of each finger")
     derived["net_force_residual"] = D.entry(np.linalg.norm(residual_F), "N", "net force residual",
@@ -359,7 +390,25 @@ def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solve
             "model": "rigid force-controlled fingertips, IPC log barrier on mid-surface samples against the "
                      "fingertip inflated by t/2", "fingers": geo,
             "contact_area_definition": "sampled surface area with gap < dhat (contact pressure > 0)",
-            "friction": "MuJoCo's contact forces less their finger-axis parts, as dead loads at the contacts"}
+            "friction": "MuJoCo's contact forces less their finger-axis parts, as dead loads at the contacts"
+                        + ("; plus the fingertips' Coulomb friction on the shell (graspdef.contact.friction: IPC's "
+                           "lagged smoothed friction, one lagging pass per load step)" if setup.friction else "")}
+    pf_mu = {s: v.get("friction_coefficient") for s, v in g.per_finger().items()}
+    data["friction"] = {
+        "mu": {s: m for s, (m, _) in setup.friction.items()} if geo else pf_mu, "mujoco_mu": pf_mu,
+        "shell_side": any(m > 0 for m, _ in setup.friction.values()),
+        "definitions": {
+            "mu": "Coulomb sliding friction coefficient of finger and object, one value for both sides (MuJoCo's "
+                  "contacts and, with geometric contact, the shell-side friction term); point loads carry MuJoCo's "
+                  "friction forces and have no shell-side friction",
+            "mujoco_mu": "the sliding friction coefficient of each finger's MuJoCo contacts (MuJoCo mixes a geom "
+                         "pair's values by taking the larger; the largest over the finger's contacts)",
+            "fingers.*.friction": "geometric contact, per finger at the last load step: n_stick / n_slip = samples "
+                                  "with a lagged normal force whose slip since the previous converged step is below / "
+                                  "at least eps_v_m; tangential_force_N = |friction force on the shell| normal to the "
+                                  "closing axis; friction_force_[xyz]_N its components (object frame); "
+                                  "lagged_normal_force_N = the normal force the friction is lagged from; max_slip_m = "
+                                  "the largest slip of the step"}}
     data["warnings"] = D.plausibility_warnings(analysis, derived["max_displacement"]["value"], spec.thickness,
                                                float(np.ptp(x_lim, axis=0).max()))
     if free and not fingertips and np.linalg.norm(setup.residual_F) > EQUILIBRIUM_RTOL * force:
@@ -385,11 +434,13 @@ def write_grasp_run(out, outcome: GraspOutcome, config: dict) -> Path:
 
 def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonlinear", out=None,
               gas: bool | None = None, settings: GraspSettings = GraspSettings(), control_faces: int | None = None,
-              steps: int | None = None, E: float | None = None, progress=None, fingertips=None) -> GraspRun:
+              steps: int | None = None, E: float | None = None, progress=None, fingertips=None,
+              friction: float | None = None) -> GraspRun:
     """Run the whole chain for ``scene`` at ``force`` [N] per finger; write the run folder ``out``
     (when given) and return its record (see the stages above for the arguments; ``progress``:
     called with a stage name and, during the path, each converged point's info; ``fingertips``: a
-    graspdef.sim.gripper.FingertipChange for this run)."""
+    graspdef.sim.gripper.FingertipChange for this run; ``friction``: the sliding friction coefficient mu of
+    fingertips and object, MuJoCo's and the shell-side term's, None: the scene's)."""
     say = progress or (lambda stage, info=None: None)
     t0 = time.perf_counter()
     if contact not in ("point", "geometric"):
@@ -397,14 +448,18 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
                            f"got {contact!r}")
     if not np.isfinite(force) or force <= 0:
         raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
+    if friction is not None:
+        from ..contact.friction import check_mu
+
+        friction = check_mu(friction, "friction coefficient (--friction)")
     check_force(scene, force, fingertips)     # the gripper's range, before the shell is built
     say("shell")
     obj = prepare_object(scene, analysis, gas, control_faces, E)
     t_shell = time.perf_counter()
     say("mujoco")
-    st = settle(obj, force, settings, fingertips)
+    st = settle(obj, force, settings, fingertips, friction)
     t_sim = time.perf_counter()
-    setup = shell_problem(obj, st, contact)
+    setup = shell_problem(obj, st, contact, friction)
     say("solve")
     solved = solve_shell(setup, analysis, steps or obj.spec.steps, progress=lambda info: say("point", info))
     t_solve = time.perf_counter()
@@ -413,7 +468,7 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     timings["total"] = time.perf_counter() - t0
     if out is not None:
         config = {"scene": str(scene), "force_N": force, "contact": contact, "analysis": analysis, "gas": gas,
-                  "control_faces": control_faces, "steps": steps, "E_Pa": E, "settings": dict(settings.__dict__),
+                  "control_faces": control_faces, "steps": steps, "E_Pa": E, "friction": friction, "settings": dict(settings.__dict__),
                   "fingertips": None if fingertips is None else dict(fingertips.__dict__),
                   "object_toml": obj.spec.file.read_text()}
         out = write_grasp_run(out, outcome, config)

@@ -77,7 +77,8 @@ class GraspResult:
             "scene": self.scene, "object": self.object, "targets_N": self.targets,
             "per_finger": {s: {"n_contacts": v["n_contacts"], "normal_force_N": v["normal_force"],
                                "friction_force_N": v["friction_force"], "force_N": v["force"].tolist(),
-                               "point_m": v["point"].tolist(), "normal": v["normal"].tolist()}
+                               "point_m": v["point"].tolist(), "normal": v["normal"].tolist(),
+                               "friction_coefficient": v.get("friction_coefficient")}
                            for s, v in pf.items()},
             "force_relative_error": self.force_errors(),
             "net_contact_force_N": self.contacts.net_force().tolist(),
@@ -92,7 +93,7 @@ def _contacts(sc: Scene, active: dict) -> ContactSet:
     mj = mujoco()
     m, d = sc.model, sc.data
     obj = set(int(g) for g in sc.object_geoms)
-    pos, nrm, frc, trq, fn, ft, fing, geoms = [], [], [], [], [], [], [], []
+    pos, nrm, frc, trq, fn, ft, fing, geoms, mu = [], [], [], [], [], [], [], [], []
     f6 = np.zeros(6)
     for i in range(d.ncon):
         c = d.contact[i]
@@ -118,11 +119,12 @@ def _contacts(sc: Scene, active: dict) -> ContactSet:
         fn.append(f6[0])
         ft.append(float(np.hypot(f6[1], f6[2])))
         fing.append(side)
+        mu.append(float(c.friction[0]))          # the contact's sliding friction (MuJoCo's geom mix)
         geoms.append((m.geom(other).name, m.geom(g2 if sign > 0 else g1).name))
     if not fing:
         return ContactSet(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0), ())
     return ContactSet(np.array(pos), np.array(nrm), np.array(frc), np.array(fn), np.array(ft), tuple(fing),
-                      tuple(geoms), np.array(trq))
+                      tuple(geoms), np.array(trq), np.array(mu))
 
 
 def _fingertip(sc: Scene, side: str, body: int, axis: np.ndarray) -> dict:
@@ -178,20 +180,22 @@ def check_targets(sc: Scene, targets: dict) -> None:
 
 
 def grasp(scene, force: float | dict, object: str, settings: GraspSettings = GraspSettings(),
-          fingertips=None) -> GraspResult:
+          fingertips=None, friction: float | None = None) -> GraspResult:
     """Close the gripper of ``scene`` (a path or a :class:`Scene`) on body ``object`` until each
     finger presses with its target force [N], settle and extract the contacts.
 
     ``force``: one number (both fingers) or {"left": F_l, "right": F_r} (0 = finger stays open;
     e.g. a one-finger poke).  ``fingertips``: a per-run
-    :class:`graspdef.sim.gripper.FingertipChange` (pad size, material).
+    :class:`graspdef.sim.gripper.FingertipChange` (pad size, material).  ``friction``: the sliding
+    friction coefficient of fingertips and object for this run (graspdef.sim.scene.load_scene;
+    None: the scene's).
 
     Raises SimError: missing gripper/object, a target outside the actuators' range, no contact
     after closing, MuJoCo warnings, or a settled force off its target by more than
     ``settings.force_rtol_error``."""
     mj = mujoco()
     t_wall = time.perf_counter()
-    sc = scene if isinstance(scene, Scene) else load_scene(scene, object, fingertips)
+    sc = scene if isinstance(scene, Scene) else load_scene(scene, object, fingertips, friction)
     m, d = sc.model, sc.data
     targets = {s: float(force) for s in SIDES} if np.isscalar(force) else {s: float(force.get(s, 0.0)) for s in SIDES}
     check_targets(sc, targets)

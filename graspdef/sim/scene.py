@@ -82,10 +82,13 @@ class Scene:
         return float(np.linalg.norm(x["right"] - x["left"]))
 
 
-def load_scene(path, object: str, fingertips=None) -> Scene:
+def load_scene(path, object: str, fingertips=None, friction: float | None = None) -> Scene:
     """Compile ``path`` (an MJCF scene) and look up the gripper and the body ``object``.
     ``fingertips``: a :class:`graspdef.sim.gripper.FingertipChange` (pad size, material) applied
-    to the scene's fingertip geoms for this run (None: the scene as written).
+    to the scene's fingertip geoms for this run (None: the scene as written).  ``friction``: the
+    sliding friction coefficient mu of this run, set on both sides of the grasp -- the fingertip
+    geoms and the object's collision geoms -- so that MuJoCo's mix of the pair (the larger of
+    the two) is mu (None: the scene's values; torsional and rolling friction stay the scene's).
 
     Raises SimError if the file does not compile, or the parallel gripper (left/right finger
     bodies, joints, actuators) or the object body is missing."""
@@ -122,5 +125,11 @@ def load_scene(path, object: str, fingertips=None) -> Scene:
         raise SimError(f"{path}: object '{object}' has no collision geoms")
     jnt = [j for j in range(model.njnt) if model.jnt_bodyid[j] == ob]
     free = any(model.jnt_type[j] == mj.mjtJoint.mjJNT_FREE for j in jnt)
+    if friction is not None:
+        from ..contact.friction import check_mu
+
+        mu = check_mu(friction, "friction coefficient (--friction)")
+        tips = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, f"{s}_{k}") for s in SIDES for k in ("pin", "pad")]
+        model.geom_friction[[g for g in tips if g >= 0] + [int(g) for g in geoms], 0] = mu
     hold = mj.mj_name2id(model, mj.mjtObj.mjOBJ_EQUALITY, f"{object}_hold")
     return Scene(path, model, data, object, ob, geoms, fingers, free, hold if hold >= 0 else None)
