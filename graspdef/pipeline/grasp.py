@@ -11,8 +11,8 @@ The chain (issue 5):
    (graspdef.contact.map_contacts); the object's weight enters as a body force, so the loads
    balance to MuJoCo's settling accuracy; the residual net force and moment are reported;
 4. a free object is held only by the fingers: its rigid-body modes are removed by
-   RigidModes (a statically determinate 3-2-1 support in nonlinear solves, whose reactions
-   are the residual); a fixed object (the duck-head poke) by point supports from object.toml;
+   RigidModes (six rows on the surface's mean displacement and mean rotation, no vertex
+   picked; their reactions are the residual); a fixed object (the duck-head poke) by point supports from object.toml;
 5. linear or nonlinear solve; the indentation (approach of the contact points) is fed back:
    predicted finger gap = rigid-proxy gap - approach, mismatch against MuJoCo's gap reported;
 6. the run folder, written by the one writer (graspdef.runs.write_run): result.json (with the
@@ -302,7 +302,7 @@ def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solve
                          "note": "geometric contact: the approach is the fingers' travel from where they touch the "
                                  "unloaded shell (advance of each force-controlled fingertip)"})
         # net force of everything acting on the shell (dead loads + contact forces): what the
-        # 3-2-1 support carries
+        # rigid-mode rows carry
         residual_F = residual_F + sum(np.asarray(r.get("contact_force_N", np.zeros(3))) for r in geo.values())
     reference = "unloaded equilibrium (load factor 0; with air: the inflated shell)" if ref is not None \
         else "rest shape"
