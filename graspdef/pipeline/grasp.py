@@ -36,7 +36,7 @@ import numpy as np
 
 from ..contact.barrier import CONTACT_PATH
 from ..contact.mapping import map_contacts
-from ..errors import ProblemError
+from ..errors import ProblemError, SolverError
 from ..objects import build_shell, load_object, scene_xml
 from ..objects.checks import check_thin_shell
 from ..problem.loads import BodyForce
@@ -236,6 +236,8 @@ def solve_shell(setup: ShellSetup, analysis: str, steps: int, progress=None) -> 
         sol = solve_contact(setup.problem, opt, linear=analysis == "linear", progress=progress) if fingertips \
             else solve_nonlinear(setup.problem, opt, progress=progress)
     except PathStopped as exc:
+        if not exc.solution.path:       # not even the unloaded state: nothing to record
+            raise SolverError(f"the shell solve found no equilibrium to record: {exc}") from None
         return Solved(exc.solution, False, str(exc))
     return Solved(sol, True, None)
 
