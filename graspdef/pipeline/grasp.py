@@ -11,8 +11,8 @@ The chain (issue 5):
    (graspdef.contact.map_contacts); the object's weight enters as a body force, so the loads
    balance to MuJoCo's settling accuracy; the residual net force and moment are reported;
 4. a free object is held only by the fingers: its rigid-body modes are removed by
-   RigidModes (a statically determinate 3-2-1 support in nonlinear solves, whose reactions
-   are the residual); a fixed object (the duck-head poke) by point supports from object.toml;
+   RigidModes (six rows on the surface's mean displacement and mean rotation, no vertex
+   picked; their reactions are the residual); a fixed object (the duck-head poke) by point supports from object.toml;
 5. linear or nonlinear solve; the indentation (approach of the contact points) is fed back:
    predicted finger gap = rigid-proxy gap - approach, mismatch against MuJoCo's gap reported;
 6. the run folder, written by the one writer (graspdef.runs.write_run): result.json (with the
@@ -36,7 +36,7 @@ import numpy as np
 
 from ..contact.barrier import CONTACT_PATH
 from ..contact.mapping import map_contacts
-from ..errors import ProblemError
+from ..errors import ProblemError, SolverError
 from ..objects import build_shell, load_object, scene_xml
 from ..objects.checks import check_thin_shell
 from ..problem.loads import BodyForce
@@ -253,6 +253,8 @@ def solve_shell(setup: ShellSetup, analysis: str, steps: int, progress=None) -> 
         sol = solve_contact(setup.problem, opt, linear=analysis == "linear", progress=progress) if fingertips \
             else solve_nonlinear(setup.problem, opt, progress=progress)
     except PathStopped as exc:
+        if not exc.solution.path:       # not even the unloaded state: nothing to record
+            raise SolverError(f"the shell solve found no equilibrium to record: {exc}") from None
         return Solved(exc.solution, False, str(exc))
     return Solved(sol, True, None)
 
@@ -319,7 +321,7 @@ def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solve
                          "note": "geometric contact: the approach is the fingers' travel from where they touch the "
                                  "unloaded shell (advance of each force-controlled fingertip)"})
         # net force of everything acting on the shell (dead loads + contact forces): what the
-        # 3-2-1 support carries
+        # rigid-mode rows carry
         residual_F = residual_F + sum(np.asarray(r.get("contact_force_N", np.zeros(3))) for r in geo.values())
         last = sol.path[-1].extra if hasattr(sol, "path") else {}
         for s, (mu, source) in setup.friction.items():

@@ -92,3 +92,20 @@ def test_slit_ring_lifted_to_full_load_with_default_settings():
     assert sol.completed
     wa = float(sol.path[-1].probes["A"][2])
     assert abs(wa / 13.891 - 1) < 0.05
+
+
+@pytest.mark.slow
+def test_slit_annular_plate_benchmark_at_sze_mesh():
+    """benchmarks/nonlinear/slit_annular_plate.toml (Sze's own 10 x 80 mesh, 1,034 control
+    vertices, default settings): every tabulated point of W_A and W_B within the file's 2 % of
+    Sze, Liu & Lo (2004)'s S4R values (problem 3.3, MBDyn's sze33_ref.dat).  Before the solves were
+    accepted by their backward error, this path crawled in steps of 4e-4 (> 400 steps, stopped at
+    a load factor of 0.3)."""
+    from pathlib import Path
+
+    from graspdef.bench import run_nonlinear_benchmark
+
+    recs = run_nonlinear_benchmark(Path(__file__).parents[2] / "benchmarks" / "nonlinear" / "slit_annular_plate.toml")
+    assert len(recs) == 46
+    bad = [(r["name"], r["value"], r["reference"]) for r in recs if not r["passed"]]
+    assert not bad, bad
