@@ -3,7 +3,12 @@ the paper's tennis-ball dimensions) squeezed by two opposite point forces up to 
 steps (issue 3's speed case).  Prints and saves (JSON) the wall time of each run -- set-up,
 path, per-step Newton iterations -- and their median.
 
-    python scripts/bench_nonlinear_speed.py [--subdivisions 5] [--runs 3] [--gas-kpa 80] [--fixed-steps] [--out out/bench_nonlinear_speed.json]
+    python scripts/bench_nonlinear_speed.py [--subdivisions 5] [--runs 3] [--gas-kpa 80] [--fixed-steps]
+                                            [--ref GIT_REF] [--out out/bench_nonlinear_speed.json]
+
+``--ref``: also run the OLD code of that git ref (checked out into a temporary worktree), its runs
+interleaved with the NEW code's (the working tree), and print both side by side (one untimed small run
+of each tree first warms its numba cache).
 
 subdivisions 5 gives 10,242 control vertices.  The ball holds air (80 kPa gauge by default, a
 tennis ball's): without it the path turns at a limit point near 3 N (the pole inverts) and never
@@ -13,11 +18,15 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
 
 CHILD = r"""
 import json, sys, time
@@ -58,6 +67,26 @@ print(json.dumps({"n_control": int(shell.mesh.n_real), "import_s": t_imp - t0, "
 """
 
 
+def _run(a, tree: Path) -> dict:
+    t0 = time.perf_counter()
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    res = subprocess.run([sys.executable, "-c", CHILD, str(a.subdivisions), str(a.steps), str(a.force), str(a.gas_kpa),
+                          "1" if a.fixed_steps else "0"], cwd=tree, env=env,
+                         stdout=subprocess.PIPE, stderr=None if a.verbose else subprocess.DEVNULL, text=True)
+    if res.returncode:
+        raise SystemExit(f"a run in {tree} failed")
+    r = json.loads(res.stdout.strip().splitlines()[-1])
+    r["wall_s"] = time.perf_counter() - t0
+    return r
+
+
+def _show(label: str, k: int, r: dict) -> None:
+    print(f"{label} run {k + 1}: {r['n_control']} control vertices, path {r['path_s']:.1f} s (set-up {r['setup_s']:.1f} s, "
+          f"factor {r['factor_s']:.1f} s, {r['factorisations']} factorisations), {r['steps']} steps, "
+          f"Newton iterations {r['newton_iterations']}, "
+          f"pole displacement {r['top_displacement_mm']:.2f} mm", flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--subdivisions", type=int, default=5)
@@ -65,29 +94,39 @@ def main() -> None:
     ap.add_argument("--force", type=float, default=20.0, help="each point force [N]")
     ap.add_argument("--gas-kpa", type=float, default=80.0, help="initial gauge pressure of enclosed air [kPa]")
     ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--ref", default=None, help="git ref of OLD code to run beside the working tree's")
     ap.add_argument("--out", default="out/bench_nonlinear_speed.json")
     ap.add_argument("--fixed-steps", action="store_true",
                     help="exactly --steps equal load steps (by default the step grows after easy steps)")
     ap.add_argument("--verbose", action="store_true", help="show each run's progress")
     a = ap.parse_args()
-    runs = []
-    for k in range(a.runs):
-        t0 = time.perf_counter()
-        res = subprocess.run([sys.executable, "-c", CHILD, str(a.subdivisions), str(a.steps), str(a.force), str(a.gas_kpa),
-                              "1" if a.fixed_steps else "0"],
-                             stdout=subprocess.PIPE, stderr=None if a.verbose else subprocess.DEVNULL, text=True)
-        if res.returncode:
-            raise SystemExit(f"run {k + 1} failed")
-        r = json.loads(res.stdout.strip().splitlines()[-1])
-        r["wall_s"] = time.perf_counter() - t0
-        runs.append(r)
-        print(f"run {k + 1}: {r['n_control']} control vertices, path {r['path_s']:.1f} s (set-up {r['setup_s']:.1f} s, "
-              f"factor {r['factor_s']:.1f} s, {r['factorisations']} factorisations), {r['steps']} steps, "
-              f"Newton iterations {r['newton_iterations']}, "
-              f"pole displacement {r['top_displacement_mm']:.2f} mm", flush=True)
-    med = {k: statistics.median(r[k] for r in runs) for k in ("path_s", "setup_s", "total_s", "factor_s")}
-    print(f"median over {a.runs} runs: path {med['path_s']:.1f} s, set-up {med['setup_s']:.1f} s, "
-          f"total (incl. imports) {med['total_s']:.1f} s")
+    trees = {"NEW": ROOT}
+    tmp = None
+    if a.ref:
+        commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", a.ref], capture_output=True, text=True,
+                                check=True).stdout.strip()
+        tmp = Path(tempfile.mkdtemp(prefix="bench_nonlinear_"))
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tmp / "old"), commit],
+                       capture_output=True, check=True)
+        trees = {"OLD": tmp / "old", "NEW": ROOT}
+    runs: dict[str, list] = {k: [] for k in trees}
+    try:
+        for tree in trees.values():            # warm numba's on-disk cache of each tree (not timed)
+            _run(argparse.Namespace(**{**vars(a), "subdivisions": 2, "steps": 2}), tree)
+        for k in range(a.runs):
+            for label, tree in trees.items():
+                r = _run(a, tree)
+                runs[label].append(r)
+                _show(label, k, r)
+    finally:
+        if tmp is not None:
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tmp / "old")], capture_output=True)
+    keys = ("path_s", "setup_s", "total_s", "factor_s", "factorisations", "steps")
+    med = {label: {key: statistics.median(r[key] for r in rs) for key in keys} for label, rs in runs.items()}
+    for label, m in med.items():
+        print(f"{label}: median over {a.runs} runs: path {m['path_s']:.1f} s, set-up {m['setup_s']:.1f} s, "
+              f"total (incl. imports) {m['total_s']:.1f} s, {m['steps']:.0f} steps, {m['factorisations']:.0f} factorisations, "
+              f"pole displacement {runs[label][0]['top_displacement_mm']:.3f} mm")
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)
     Path(a.out).write_text(json.dumps({"case": vars(a), "runs": runs, "median": med}, indent=2) + "\n")
     print(f"wrote {a.out}")
