@@ -56,6 +56,7 @@ EPILOG = """examples:
   graspdef report out/grasp_tennis_ball                            # -> out/grasp_tennis_ball/report.html
   graspdef sweep sweeps/smoke.toml --out out/sweep_smoke            # local, 2 worker processes
   graspdef sweep sweeps/smoke.toml --out /shared/sweep --scheduler tcp://10.0.0.5:8786
+  graspdef fit tennis_ball --data scenes/tennis_ball/table1_tian_jia_2010.csv --params E,pressure --out out/fit_tb
 """
 
 
