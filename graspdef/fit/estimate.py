@@ -35,6 +35,10 @@ CORRELATION_LIMIT = 0.95
 CONDITION_LIMIT = 1e8
 #: forward-difference step in the log-parameters (0.1 % of each parameter)
 FD_STEP = 1e-3
+#: the optimiser stops when a step changes the log-parameters by less than this (relative 1e-6: far
+#: below any standard error a measured table gives; scipy's default 1e-8 spends its last evaluations
+#: on steps of 1e-8 near the minimum)
+XTOL = 1e-6
 #: each parameter is searched within [start / BOUND, start * BOUND]
 BOUND = 100.0
 #: weight of the rows of a table without a sigma column [m] (any constant gives the same estimate
@@ -144,6 +148,7 @@ class FitResult:
                                    f"(each parameter x e^h, +{(math.exp(self.fd_step) - 1) * 100:.3g} %)",
                        "covariance": "s^2 (J^T J)^-1 in log-parameters, s^2 = chi2 / dof; std = value * sqrt(cov_ii)",
                        "bounds": f"[start / {BOUND:g}, start * {BOUND:g}]",
+                       "xtol": XTOL,
                        "sigma": "the table's sigma column" if t.sigma is not None else
                                 f"none in the table: every row weighted alike (sigma = {UNIT_SIGMA:g} m)"},
             "cost": {"forward_evaluations": self.n_evaluations, "forward_solves": self.n_solves,
@@ -255,7 +260,8 @@ def fit(model: Callable[[dict], np.ndarray], table: MeasuredTable, start: dict, 
 
     lo, hi = z0 - math.log(bound), z0 + math.log(bound)
     try:
-        res = least_squares(fun, z0, jac=jac, bounds=(lo, hi), method="trf", max_nfev=max_nfev, x_scale=1.0)
+        res = least_squares(fun, z0, jac=jac, bounds=(lo, hi), method="trf", max_nfev=max_nfev, x_scale=1.0,
+                            xtol=XTOL)
         z, converged, message = res.x, bool(res.status > 0), str(res.message)
         J = jac(z)
     except ForwardFailed as exc:
