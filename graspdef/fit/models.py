@@ -61,14 +61,17 @@ class ObjectModel:
         self.names, self.table, self.analysis, self.contact = list(names), table, analysis, contact
         if "pressure" in self.names and analysis != "nonlinear":
             raise ProblemError("pressure (the enclosed air) needs --analysis nonlinear (p V = const is nonlinear)")
+        from ..objects import load_object
+
+        spec = load_object(scene)                     # checked before any heavy work
+        if "pressure" in self.names and spec.gas is None:
+            raise ProblemError(f"{spec.file}: no [gas] table: the object has no enclosed air whose pressure could "
+                               "be fitted")
         for f in sorted(set(table.force.tolist())):
             check_force(scene, f)                      # the gripper's range, before the shell is built
         say("building the shell from the object's data")
         self.obj = prepare_object(scene, analysis)
         spec = self.obj.spec
-        if "pressure" in self.names and spec.gas is None:
-            raise ProblemError(f"{spec.file}: no [gas] table: the object has no enclosed air whose pressure could "
-                               "be fitted")
         self.steps = steps or spec.steps
         self.outer, _ = outer_surface(spec)
         self.settled = {}

@@ -42,6 +42,8 @@ CASES = {
                                  "--params", "E"], "unknown point 'elbow'"),
     "pressure with the linear shell": (lambda t: ["tennis_ball", "--data", _csv(t, GOOD), "--params", "E,pressure",
                                                   "--analysis", "linear"], "needs --analysis nonlinear"),
+    "pressure of an object without air": (lambda t: ["duck", "--data", _csv(t, GOOD), "--params", "E,pressure"],
+                                           "no [gas] table"),
     "--out holds other files": (lambda t: ["tennis_ball", "--data", _csv(t, GOOD), "--params", "E", "--out",
                                            str(t / "photos")], "not a graspdef run folder"),
 }
