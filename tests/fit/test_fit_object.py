@@ -39,3 +39,17 @@ def test_a_thinner_wall_indents_by_about_t_to_the_minus_two(model):
     ratio = u20[0] / u25[0]
     print(f"\nindentation at 10 N: {u25[0] * 1e3:.3f} mm (t = 2.5 mm), {u20[0] * 1e3:.3f} mm (2.0 mm): ratio {ratio:.3f}")
     assert ratio == pytest.approx(1.5625, rel=0.15)
+
+
+def test_air_pressure_enters_the_nonlinear_chain():
+    """Nonlinear shell with air: theta's pressure is the run record's gas p0, and less air indents
+    more (20 kPa vs object.toml's 80 kPa at 10 N per finger)."""
+    table = MeasuredTable(np.array([10.0]), np.zeros(1), ("finger",))
+    m = ObjectModel("tennis_ball", table, ["pressure"], "nonlinear")
+    assert m.start() == {"pressure": 80e3}
+    rec = m.record({"pressure": 20e3}, 10.0)
+    assert rec["gas_p0_Pa"] == 20e3 and rec["convergence"]["completed"]
+    soft = rec["derived"]["indentation_per_finger"]["value"]
+    stiff = m({"pressure": 80e3})[0]
+    print(f"\nindentation at 10 N: {soft * 1e3:.3f} mm (20 kPa), {stiff * 1e3:.3f} mm (80 kPa)")
+    assert soft > 1.2 * stiff > 0
