@@ -76,3 +76,36 @@ def test_hinged_roof_coarse_limit_point(tmp_path):
     assert abs(at["rel_error"]) <= 0.03, at
     worst = max(abs(r["rel_error"]) for r in records if "reaction.C @" in r["name"])
     assert worst <= 0.04, worst
+
+
+def test_hinged_roof_arc_length_finds_both_limit_points(tmp_path):
+    """The same 16 x 16 roof under the central force P = P_max (750 on the 1/4 model) by arc
+    length: the path's critical points are the limit load (stability 0 -> 1) and the minimum
+    after the snap (1 -> 0), where displacement control found them.  Measured: 0.73939 at
+    -W_C = 10.70 (displacement control and the parabola: 0.7393 at 10.68; Sze 0.7437 at 10.88) and
+    0.17170 at 19.47 (Sze's table: 0.1729 at 19.85).  15 s alone on the shared machine."""
+    from graspdef.problem.config import load_problem
+    from graspdef.solve.nonlinear import path_options, solve_nonlinear
+
+    text = (NL / "hinged_roof.toml").read_text()
+    text = text.replace("n_theta = 32", "n_theta = 16").replace("n_z = 32", "n_z = 16")
+    support = ('[[supports]]\nkind = "point"\nname = "C"\nat = [0.0, 2540.0, 0.0]\n'
+               'directions = [[0.0, 1.0, 0.0]]\ndisplacement = [-30.0]\n')
+    solver = '[solver]\ntype = "nonlinear"\nmethod = "load"\nsteps = 60\nmax_steps = 2000\n'
+    assert support in text and solver in text
+    text = text.replace(support, '[[loads]]\nkind = "point"\nat = [0.0, 2540.0, 0.0]\nforce = [0.0, -750.0, 0.0]\n')
+    text = text.replace(solver, '[solver]\ntype = "nonlinear"\nmethod = "arc_length"\nsteps = 40\n'
+                                'max_steps = 400\nmax_probe_displacement = 30.0\n')
+    path = tmp_path / "hinged_roof_arc.toml"
+    path.write_text(text)
+    spec = load_problem(path)
+    sol = solve_nonlinear(spec.problem, path_options(spec.solver), backend=spec.backend)
+    limits = [cp for cp in sol.critical_points if cp["kind"] == "limit point"]
+    assert len(limits) >= 2, sol.critical_points
+    top, bottom = limits[0], limits[1]
+    assert (top["instability_before"], top["instability_after"]) == (0, 1)
+    assert (bottom["instability_before"], bottom["instability_after"]) == (1, 0)
+    assert abs(top["load_factor"] - 0.7437) <= 0.03 * 0.7437, top
+    assert abs(-top["probes"]["C"][1] - 10.88) <= 0.03 * 10.88, top
+    # the minimum against max |P/P_max| = 1.0835, as the benchmark compares the curve
+    assert abs(bottom["load_factor"] - 0.1729) <= 0.03 * 1.0835, bottom
