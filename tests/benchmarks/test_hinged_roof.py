@@ -61,8 +61,8 @@ def test_hinged_roof_matches_sze_within_the_benchmark_tolerance():
 
 
 def test_hinged_roof_coarse_limit_point(tmp_path):
-    """16 x 16 on the 1/4 model (289 control vertices; 5 s, 16 s on a cold numba cache).  The limit load and the
-    deflection at it within the benchmark's 3 % (measured -0.60 % and -1.81 %).  The curve within
+    """16 x 16 on the 1/4 model (289 control vertices; 5 s, 16 s on a cold numba cache).  The limit
+    load and the deflection at it within the benchmark's 3 % (measured -0.60 % and -1.81 %).  The curve within
     4 %: the 3 % of the benchmark plus the discretisation error of the coarse mesh, bounded by
     twice the measured change from 16 x 16 to 32 x 32 (at most 0.43 % of max |P|); measured worst
     +3.36 %, at the end of the stiffening branch."""
