@@ -62,10 +62,11 @@ def test_hinged_roof_matches_sze_within_the_benchmark_tolerance():
 
 def test_hinged_roof_coarse_limit_point(tmp_path):
     """16 x 16 on the 1/4 model (289 control vertices; 5 s, 16 s on a cold numba cache).  The limit
-    load and the deflection at it within the benchmark's 3 % (measured -0.60 % and -1.81 %).  The curve within
-    4 %: the 3 % of the benchmark plus the discretisation error of the coarse mesh, bounded by
-    twice the measured change from 16 x 16 to 32 x 32 (at most 0.43 % of max |P|); measured worst
-    +3.36 %, at the end of the stiffening branch."""
+    load and the deflection at it within the benchmark's 3 % (measured -0.60 % and -1.81 %), and the
+    curve within the same 3 % up to the minimum after the snap (-W_C <= 20 of the 30 prescribed;
+    measured worst -1.82 %, at the limit).  The end of the
+    stiffening branch after it (+3.36 % at this mesh, +2.93 % at 32 x 32) is left to the slow test
+    at the benchmark's own mesh: no tolerance is widened for the coarse mesh."""
     text = (NL / "hinged_roof.toml").read_text()
     assert "n_theta = 32" in text and "n_z = 32" in text
     spec = tmp_path / "hinged_roof_16.toml"
@@ -76,8 +77,10 @@ def test_hinged_roof_coarse_limit_point(tmp_path):
     at = _record(records, "displacement at the limit load")
     assert abs(limit["rel_error"]) <= 0.03, limit
     assert abs(at["rel_error"]) <= 0.03, at
-    worst = max(abs(r["rel_error"]) for r in records if "reaction.C @" in r["name"])
-    assert worst <= 0.04, worst
+    upto_min = [r for r in records if "reaction.C @" in r["name"] and float(r["name"].split("@")[1]) <= 20.0 / 30.0]
+    assert len(upto_min) >= 10
+    worst = max(abs(r["rel_error"]) for r in upto_min)
+    assert worst <= 0.03, worst
 
 
 def test_hinged_roof_arc_length_finds_both_limit_points(tmp_path):
