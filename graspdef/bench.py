@@ -221,6 +221,8 @@ def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda
                         "n_control": n_control, "seconds": seconds, "source": ref.get("source", ""),
                         "units": spec.length_unit})
 
+    if "limit_point" in ref:
+        _limit_point_records(spec, sol, ref, record)
     if ref.get("compare", "each") == "curve":
         _curve_records(spec, sol, ref, lfs, values, record)
         return records
@@ -234,11 +236,48 @@ def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda
             record(f"|{', '.join(values)}| @ {lf:g}", np.linalg.norm(r), np.linalg.norm(v),
                    np.linalg.norm(v - r) / np.linalg.norm(r))
         return records
+    rn = set(ref.get("range_normalised", []))
     for expr, vals in values.items():
+        denom = max(abs(x) for x in vals) if expr in rn else None
         for lf, reference in zip(lfs, vals):
-            value = _point_quantity(spec, sol, sol.at(lf), expr)
-            record(f"{expr} @ {lf:g}", reference, value, (value - reference) / abs(reference))
+            value = _path_quantity(spec, sol, sol.at(lf), expr, ref)
+            record(f"{expr} @ {lf:g}", reference, value, (value - reference) / (denom or abs(reference)))
     return records
+
+
+def _path_quantity(spec, sol, point, expr: str, ref) -> float:
+    """``[-]reaction.NAME`` (times ``[reference] reaction_scale``) or a ``quantity`` form."""
+    sign, body = (-1.0, expr[1:]) if expr.startswith("-") else (1.0, expr)
+    if body.startswith("reaction."):
+        return sign * _abscissa(point, body, float(ref.get("reaction_scale", 1.0)))
+    return _point_quantity(spec, sol, point, expr)
+
+
+def _limit_point_records(spec, sol, ref, record):
+    """``[reference.limit_point]``: the first maximum of ``load`` (e.g. ``reaction.C``, scaled by
+    ``reaction_scale``) along the path against ``displacement`` (e.g. ``-probe.C.y``): the
+    parabola through the largest path point and its two neighbours gives the limit load and the
+    displacement at it (compared with the keys ``value`` and ``at``, pointwise relative errors)."""
+    lp = ref["limit_point"]
+    pts = [p for p in sol.path if p.kind != "refine"]
+    P = np.array([_path_quantity(spec, sol, p, lp["load"], ref) for p in pts])
+    W = np.array([_path_quantity(spec, sol, p, lp["displacement"], ref) for p in pts])
+    peaks = [i for i in range(1, len(P) - 1) if P[i] >= P[i - 1] and P[i] > P[i + 1]]
+    if not peaks:
+        record("limit load", lp["value"], float("nan"), float("nan"))
+        record("displacement at the limit load", lp["at"], float("nan"), float("nan"))
+        return
+    w, p = parabola_peak(W[peaks[0] - 1:peaks[0] + 2], P[peaks[0] - 1:peaks[0] + 2])
+    record("limit load", lp["value"], p, (p - lp["value"]) / abs(lp["value"]))
+    record("displacement at the limit load", lp["at"], w, (w - lp["at"]) / abs(lp["at"]))
+
+
+def parabola_peak(x, y) -> tuple[float, float]:
+    """Vertex (x, y) of the parabola through three points (x increasing, the middle y largest)."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    c = np.polyfit(x - x[1], y, 2)
+    xm = -c[1] / (2.0 * c[0])
+    return float(x[1] + xm), float(np.polyval(c, xm))
 
 
 def _abscissa(point, expr: str, scale: float) -> float:

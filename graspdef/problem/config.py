@@ -57,7 +57,8 @@ _SOLVER = {"backend": "str", "collocation": "int", "type": "str", "method": "str
 _LENGTH_KEYS = {"lx", "ly", "center", "a", "b", "c", "radius", "length", "half_width", "scale", "r_inner", "r_outer",
                 "edge_length"}
 _REFERENCE = {"value", "quantity", "tolerance", "source", "formula", "load_factors", "values", "curve",
-              "curve_params", "compare", "abscissa", "abscissa_scale", "range_normalised"}
+              "curve_params", "compare", "abscissa", "abscissa_scale", "range_normalised",
+              "reaction_scale", "limit_point"}
 _SUPPORT_KEYS = {"rigid_modes": ({"kind", "name"}, ()),
                  "point": ({"kind", "name", "at", "face", "bary", "directions", "tolerance", "displacement", "side"},
                            ())}
