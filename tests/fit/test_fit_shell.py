@@ -74,9 +74,11 @@ def test_E_and_pressure_recovered_from_pinch_and_bulge():
     assert r.n_solves == r.n_evaluations          # one load path per evaluation (all forces as targets)
 
 
+@pytest.mark.slow
 def test_pinch_alone_does_not_separate_E_and_pressure():
     """The same shell and air, only the indentation rows: the fit warns that E and pressure are not
-    separately identifiable from these data."""
+    separately identifiable from these data.  Slow (24 s on a loaded machine): the default suite keeps
+    the linear shell's E-thickness trade-off and the estimator's product test for the warning."""
     table = synthetic(("finger",), {"E": TRUE["E"], "pressure": TRUE["pressure"]}, "nonlinear")
     r = _fit(table, ["E", "pressure"], "nonlinear")
     assert any("E and pressure are not separately identifiable" in w for w in r.warnings), r.warnings
