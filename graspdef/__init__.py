@@ -47,7 +47,7 @@ _LAZY = {
 #: the rooms (ARCHITECTURE.md) reachable as ``graspdef.<room>``, imported on first use (not cli, testing)
 _SUBPACKAGES = {"units", "runtime", "config", "geometry", "runs", "subdivision", "shell", "axisym", "problem", "solve",
                 "contact", "sim", "scans", "registration", "objects", "viewer", "report", "pipeline", "ranking",
-                "sweep", "bench"}
+                "fit", "sweep", "bench"}
 
 __all__ = sorted(["GraspdefError", "MeshError", "ProblemError", "SolverError", "SupportError", *_LAZY])
 

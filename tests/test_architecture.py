@@ -13,7 +13,7 @@ PKG = Path(__file__).resolve().parents[1] / "graspdef"
 #: lowest first; a module may import graspdef modules of its own layer or of a lower one
 LAYERS = ["errors", "units", "runtime", "config", "testing", "geometry", "runs", "subdivision", "shell", "axisym",
           "problem", "solve", "contact", "sim", "scans", "registration", "objects", "viewer", "report", "pipeline", "ranking",
-          "sweep", "bench", "cli"]
+          "fit", "sweep", "bench", "cli"]
 #: sibling rooms that must not import each other (ARCHITECTURE.md: "viewer | report")
 SIBLINGS = [("viewer", "report")]
 HEAVY = {"mujoco", "open3d", "viser"}

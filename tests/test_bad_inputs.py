@@ -237,6 +237,17 @@ def _case(name: str, tmp: Path) -> tuple[list[str], str]:
                                                    "beyond what the gripper"),
         "rank: --out holds other files": lambda: (["rank", "test_sphere", "--force", "5", "--out", str(tmp / "photos")],
                                                   "not a graspdef run folder"),
+        # --- fit
+        "fit: missing data file": lambda: (["fit", "tennis_ball", "--data", str(tmp / "no.csv"), "--params", "E",
+                                            "--out", out], "data table not found"),
+        "fit: header without units": lambda: (["fit", "tennis_ball", "--data", _file(tmp, "d.csv", "force,displacement\n"
+                                               "10,2\n"), "--params", "E", "--out", out], "states no unit"),
+        "fit: unknown parameter": lambda: (["fit", "tennis_ball", "--data", _file(tmp, "d.csv", "force_N,displacement_mm\n"
+                                            "10,2\n"), "--params", "mu", "--out", out], "unknown parameter 'mu'"),
+        "fit: non-positive force": lambda: (["fit", "tennis_ball", "--data", _file(tmp, "d.csv", "force_N,displacement_mm\n"
+                                             "-1,2\n"), "--params", "E", "--out", out], "force must be positive"),
+        "fit: fewer rows than parameters": lambda: (["fit", "tennis_ball", "--data", _file(
+            tmp, "d.csv", "force_N,displacement_mm\n10,2\n"), "--params", "E,pressure", "--out", out], "1 rows for 2"),
         # --- bench
         "bench: missing folder": lambda: (["bench", "linear", "--dir", str(tmp / "nowhere")], "nowhere"),
     }
@@ -262,7 +273,9 @@ NAMES = sorted([
     "rank: force that is not a number", "rank: no candidates", "rank: strain limit above 100 %",
     "rank: pad size beyond the gripper's", "rank: --chunks without Dask", "rank: an object with a gas",
     "rank: unknown object", "rank: --out holds other files", "rank: force range reversed",
-    "rank: force and force range", "rank: force beyond the gripper"])
+    "rank: force and force range", "rank: force beyond the gripper",
+    "fit: missing data file", "fit: header without units", "fit: unknown parameter", "fit: non-positive force",
+    "fit: fewer rows than parameters"])
 
 
 def test_the_matrix_has_at_least_30_classes():

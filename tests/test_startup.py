@@ -108,6 +108,7 @@ def test_every_subcommand_module_has_the_protocol():
     ["view", "out/plate", "--port", "8081"],
     ["report", "out/plate"],
     ["score", "a.ply", "ycb_056_tennis_ball", "--out", "sc"],
+    ["fit", "tennis_ball", "--data", "t.csv", "--params", "E,pressure", "--analysis", "linear", "--out", "f"],
 ])
 def test_the_one_subcommand_parser_parses_as_the_whole_one(argv):
     """The parser ``main`` builds (the requested subcommand's arguments alone) gives the same

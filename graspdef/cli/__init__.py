@@ -12,6 +12,7 @@ argparse stops here: a subcommand turns its arguments into typed inputs and call
     graspdef object show SCENE                 what a grasp of this object will use (law, E, nu, gas)
     graspdef object add NAME --mesh FILE ...   a mesh of your own -> an object folder to grasp
     graspdef rank OBJECT --force F --out DIR   where to grasp: antipodal candidates ranked (linear screen)
+    graspdef fit OBJECT --data TABLE.csv --params E,pressure [--out DIR]   material parameters from measurements
 
 Every error a user can cause prints one line ``graspdef: error: ...`` and exits with status 2.
 Building the parser imports no numerical package, and :func:`main` imports the module of the one
@@ -40,6 +41,7 @@ COMMANDS = {
     "object": ("obj", ("add an object of your own from a mesh file (object add), or show an object's data "
                        "(object show)")),
     "rank": ("rank", "rank antipodal grasp candidates of an object by the work its shell takes (linear screen)"),
+    "fit": ("fit", "fit E, air pressure or thickness of an object to a measured force-displacement table (fit.json)"),
 }
 
 EPILOG = """examples:
@@ -54,6 +56,7 @@ EPILOG = """examples:
   graspdef report out/grasp_tennis_ball                            # -> out/grasp_tennis_ball/report.html
   graspdef sweep sweeps/smoke.toml --out out/sweep_smoke            # local, 2 worker processes
   graspdef sweep sweeps/smoke.toml --out /shared/sweep --scheduler tcp://10.0.0.5:8786
+  graspdef fit tennis_ball --data scenes/tennis_ball/table1_tian_jia_2010.csv --params E,pressure --out out/fit_tb
 """
 
 

@@ -1,0 +1,82 @@
+"""``graspdef fit``'s library side: an object, a measured table and the parameters to fit ->
+:class:`~graspdef.fit.estimate.FitResult`, and the fit folder (``fit.json`` and a copy of the
+table)."""
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+from typing import Callable
+
+from ..errors import ProblemError
+from ..units import quantity
+from .estimate import PARAMETERS, FitResult, fit, parse_names
+from .table import read_table
+
+#: the file a fit folder holds (and is recognised by: a fit folder is replaced, other folders refused)
+FIT_FILE = "fit.json"
+
+
+def parse_start(text: str | None, names: list) -> dict:
+    """``"E=2MPa,pressure=50kPa"`` -> {"E": 2e6, "pressure": 5e4} (SI); each value needs a unit."""
+    out = {}
+    for item in [t for t in (text or "").split(",") if t.strip()]:
+        name, eq, value = item.partition("=")
+        name = name.strip()
+        if not eq:
+            raise ProblemError(f"--start: {item.strip()!r} is not NAME=VALUE (e.g. E=2MPa)")
+        if name not in names:
+            raise ProblemError(f"--start: {name!r} is not a parameter being fitted ({', '.join(names)})")
+        v = quantity(value.strip(), PARAMETERS[name].dimension, what=f"--start {name}")
+        if not v > 0:
+            raise ProblemError(f"--start {name}: must be positive, got {value.strip()!r}")
+        out[name] = v
+    return out
+
+
+def fit_object(scene, data, params: str, analysis: str = "nonlinear", out=None, start: str | None = None,
+               max_iterations: int = 30, progress: Callable[[str], None] | None = None) -> FitResult:
+    """Fit ``params`` (``"E,pressure"``) of the object of ``scene`` to the table ``data`` (a CSV
+    file, graspdef.fit.table) through its grasp chain (:class:`~graspdef.fit.models.ObjectModel`,
+    ``analysis`` linear or nonlinear, point loads).  Start: object.toml's values, or ``start``
+    (``"E=2MPa"``).  ``out``: the folder to write fit.json (and data.csv, the table) to."""
+    from ..runs.folder import atomic_folder, check_output_folder
+    from .models import ObjectModel
+
+    say = progress or (lambda msg: None)
+    if analysis not in ("linear", "nonlinear"):
+        raise ProblemError(f"analysis must be 'linear' or 'nonlinear', got {analysis!r}")
+    if not (isinstance(max_iterations, int) and max_iterations >= 1):
+        raise ProblemError(f"--max-iterations must be a positive integer, got {max_iterations!r}")
+    names = parse_names(params)
+    table = read_table(data)
+    if len(table) < len(names):
+        raise ProblemError(f"{table.file}: {len(table)} rows for {len(names)} parameters ({', '.join(names)}): a fit "
+                           "needs at least as many rows as parameters")
+    given = parse_start(start, names)
+    if out is not None:
+        check_output_folder(out, FIT_FILE)
+    model = ObjectModel(scene, table, names, analysis, progress=say)
+    theta0 = {**model.start(), **given}
+    missing = [n for n in names if n not in theta0]
+    if missing:
+        raise ProblemError(f"no start value for {', '.join(missing)}: give --start")
+
+    def step(info):
+        th = ", ".join(f"{k} {v / _unit(k):.5g} {PARAMETERS[k].display}" for k, v in info["theta"].items())
+        say(f"evaluation {info['evaluations']}: {th}: RMS residual {info['rms_m'] * 1e3:.4g} mm")
+
+    say(f"fitting {', '.join(names)} to {len(table)} rows ({len(set(table.force.tolist()))} forces)")
+    result = fit(model, table, {n: theta0[n] for n in names}, max_nfev=max_iterations, progress=step)
+    if out is not None:
+        with atomic_folder(out) as tmp:
+            (Path(tmp) / FIT_FILE).write_text(json.dumps(result.to_json(), indent=2) + "\n")
+            shutil.copyfile(table.file, Path(tmp) / "data.csv")
+    return result
+
+
+def _unit(name: str) -> float:
+    from ..units import unit_factor
+
+    p = PARAMETERS[name]
+    return unit_factor(p.display, p.dimension)
