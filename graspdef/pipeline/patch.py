@@ -229,3 +229,132 @@ def patch_info(pp: PatchProblem) -> dict:
             "mean_edge_m": mean_edge(pp.patch.vertices, pp.patch.faces), "axes": pp.patch.axes.tolist(),
             "load_point_m": pp.point.tolist(), "outward_normal": pp.normal.tolist(), "force_N": pp.force,
             "contact_to_surface_m": pp.contact_distance}
+
+
+# ------------------------------------------------------------------------------------------------
+# the grasp chain with the patch model (graspdef.pipeline.grasp.run_grasp(model="patch"))
+
+def patch_setups(obj, st, size: float = PATCH_SIZE, analysis: str = "nonlinear", levels: int | None = None,
+                 forces: dict | None = None) -> list:
+    """One :class:`PatchProblem` per finger of MuJoCo's settled grasp ``st`` (graspdef.pipeline.grasp
+    Settled) on ``obj``'s shell (GraspObject): the patch around the finger's force-weighted mean contact
+    point (object frame), loaded by its settled normal force (or ``forces[finger]`` [N])."""
+    size = check_size(size)
+    shell, spec, g = obj.shell, obj.spec, st.g
+    extent = float(np.ptp(shell.rest_positions[: shell.mesh.n_real], axis=0).max())
+    lv = default_levels(shell, size) if levels is None else int(levels)
+    if lv < 0:
+        raise ProblemError(f"patch refinement levels must be >= 0, got {levels!r}")
+    xc, fc = refined_control_mesh(shell, lv)
+    material = patch_material(spec.material, analysis)
+    if size > extent:
+        raise ProblemError(f"--patch-size {size * 1e3:.3g} mm is larger than the object ({extent * 1e3:.3g} mm "
+                           "across)")
+    pf = g.contacts.transformed(g.pose).per_finger()
+    out = []
+    for s in sorted(pf):
+        if st.targets.get(s, 0.0) <= 0 or pf[s]["n_contacts"] == 0:
+            continue
+        F = float(pf[s]["normal_force"] if forces is None else forces[s])
+        out.append(build_patch(xc, fc, material, spec.thickness, pf[s]["point"], F, size, s, lv))
+    if not out:
+        raise ProblemError("patch model: MuJoCo's settled grasp has no finger in contact with the object")
+    return out
+
+
+def patch_record(obj, st, pps: list, solved: list, force: float, analysis: str, timings: dict):
+    """The run record and arrays (graspdef.pipeline.grasp.GraspOutcome) of the patch model:
+    ``solved`` holds per patch (u at its force, the solution object)."""
+    from ..runs import derived as D
+    from ..runs.record import SI_UNITS, RunRecord
+    from ..shell.energy import ShellEnergy
+    from .grasp import GraspOutcome
+
+    spec, g = obj.spec, st.g
+    pf = g.per_finger()
+    fingers, patches = {}, {}
+    rest, deformed, faces, disp = [], [], [], []
+    strain, offset = 0.0, 0
+    conv = {"completed": True, "stop_reason": None, "patches": {}}
+    for pp, (u, sol) in zip(pps, solved):
+        s = pp.finger
+        m = patch_measures(pp, u)
+        patches[s] = {**patch_info(pp), **m}
+        fingers[s] = {"target_N": st.targets[s], "normal_force_N": pf[s]["normal_force"],
+                      "axial_force_N": g.info["axial_force_N"][s], "friction_force_N": pf[s]["friction_force"],
+                      "n_contacts": pf[s]["n_contacts"], "load_point_m": pp.point.tolist(),
+                      "displacement_m": m["load_point_displacement_m"],
+                      "displacement_along_normal_m": m["displacement_along_push_m"],
+                      "max_displacement_m": m["max_displacement_m"]}
+        Lm = sol.limit_map()
+        x0 = Lm @ pp.problem.shell.rest_positions
+        ul = Lm @ u
+        rest.append(x0)
+        deformed.append(x0 + ul)
+        disp.append(ul)
+        mesh = pp.problem.shell.mesh
+        faces.append(mesh.faces[: mesh.n_real_faces] + offset)
+        offset += len(x0)
+        if analysis == "linear":
+            strain += float(sol.strain_energy)
+            conv["patches"][s] = {"relative_residual": sol.kkt.residual}
+        else:
+            strain += float(ShellEnergy(pp.problem.shell).energy(pp.problem.shell.rest_positions + u))
+            conv["patches"][s] = {"load_factor": sol.load_factor, "n_points": len(sol.path),
+                                  "newton_iterations": sol.iterations(), "n_factorisations": sol.n_factorisations}
+    rest, deformed, disp, faces = (np.concatenate(a) for a in (rest, deformed, disp, faces))
+    reference = "rest shape (the patch model has no air)"
+    derived = {"max_displacement": D.max_displacement(rest, disp, "m", rigid_motion_removed=False, reference=reference)}
+    derived["max_displacement"]["definition"] = (
+        "largest |u| over the limit-surface vertices of the mid-surface of every finger's patch (patch model: "
+        "the rest of the object is fixed, the patch border clamped, so no rigid motion); u from the rest shape")
+    derived["max_displacement_per_finger"] = D.entry(
+        {s: p["max_displacement_m"] for s, p in patches.items()}, "m", "max. displacement per finger",
+        "patch model: largest |u| over the limit-surface vertices of the finger's patch (Table I's measured max. "
+        "displacement)")
+    push = [f["displacement_along_normal_m"] for f in fingers.values()]
+    if len(push) == 2:
+        derived["indentation_per_finger"] = D.entry(
+            float(np.mean(push)), "m", "indentation per finger",
+            "patch model: mean displacement of the fingers' load points along their push (inward normal)")
+        feedback = {"approach_m": float(sum(push)), "indentation_per_finger_m": float(np.mean(push)),
+                    "mujoco_tip_gap_m": g.tip_gap, "predicted_tip_gap_m": g.tip_gap - float(sum(push)),
+                    "mismatch_m": float(sum(push)),
+                    "note": "patch model: approach = sum of the load points' displacements along their pushes"}
+    else:
+        derived["indentation"] = D.entry(float(push[0]), "m", "indentation",
+                                         "patch model: displacement of the load point along the finger's push")
+        feedback = {"indentation_m": float(push[0]), "mujoco_tip_gap_m": g.tip_gap, "mismatch_m": float(push[0])}
+    derived["finger_force"] = D.entry({s: f["normal_force_N"] for s, f in fingers.items()}, "N",
+                                      "normal force per finger", "MuJoCo's settled normal contact force of each finger")
+    derived["strain_energy"] = D.entry(strain, "J", "strain energy",
+                                       "elastic energy of the patches at the final state, from their stress-free shape")
+    size = pps[0].size
+    data = {
+        "scene": str(obj.xml), "object": spec.body, "force_N": force, "contact": "point", "model": "patch",
+        "patch_size_m": size,
+        "patch_model": {
+            "definition": "Tian & Jia 2010, Sec. IX-A: one subdivision displacement field per finger contact over a "
+                          "square patch of side patch_size_m in the tangent plane at the contact (no deeper than "
+                          "patch_size_m / 2 below it), the rest of the object fixed: the patch border clamped "
+                          "(displacement at two Gauss points per edge, rotation about the border by Nitsche's method), "
+                          "the finger's settled normal force as a point load along the inward normal, nu = 0.5, no air",
+            "patches_definitions": {
+                "max_displacement_m": "largest |u| over the patch's limit-surface vertices",
+                "displacement_along_push_m": "the load point's displacement along the inward normal",
+                "border.max_displacement_m": "largest |u| on the border's limit curve (4 points per edge)",
+                "border.max_rotation_rad": "largest rotation about the border on it: (n' - n) . conormal",
+                "refine_levels": "Loop refinements of the object's control mesh before the cut (same limit surface)"}},
+        "patches": patches,
+        "material": {"model": dataclasses.replace(spec.material, nu=PATCH_NU).model(analysis),
+                     "E_Pa": spec.material.E, "nu": PATCH_NU, "thickness_m": spec.thickness,
+                     "object_nu": spec.material.nu},
+        "thickness_m": spec.thickness, "gas_p0_Pa": 0.0, "shell": obj.shell_info,
+        "fingers": fingers, "feedback": feedback, "displacement_reference": reference,
+        "mujoco": g.record(), "convergence": conv, "timings_s": timings,
+    }
+    data["warnings"] = D.plausibility_warnings(analysis, derived["max_displacement"]["value"], spec.thickness, size)
+    rec = RunRecord("grasp", spec.body, analysis, dict(SI_UNITS), derived, {}, data)
+    contacts = {"frame": "world", "units": {"length": "m", "force": "N"}, "object_pose": g.pose.record(),
+                "contacts": g.contacts.records(), "per_finger": data["mujoco"]["per_finger"]}
+    return GraspOutcome(rec, rest, deformed, faces, disp, contacts, None, {})
