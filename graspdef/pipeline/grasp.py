@@ -471,6 +471,10 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     check_force(scene, force, fingertips)     # the gripper's range, before the shell is built
     say("shell")
     obj = prepare_object(scene, analysis, gas, control_faces, E)
+    if model == "patch":
+        from .patch import check_object_size
+
+        check_object_size(obj.shell, patch_size)      # before MuJoCo
     t_shell = time.perf_counter()
     say("mujoco")
     st = settle(obj, force, settings, fingertips, friction)

@@ -101,6 +101,17 @@ def check_size(size, name: str = "--patch-size") -> float:
     return s
 
 
+def check_object_size(shell: Shell, size) -> float:
+    """``size`` [m] as a float; a patch wider than the object (its largest extent along x, y or z)
+    is refused: nothing of the object would be left to hold the border."""
+    size = check_size(size)
+    extent = float(np.ptp(shell.rest_positions[: shell.mesh.n_real], axis=0).max())
+    if size > extent:
+        raise ProblemError(f"--patch-size {size * 1e3:.3g} mm is larger than the object ({extent * 1e3:.3g} mm "
+                           "across)")
+    return size
+
+
 @dataclass
 class PatchProblem:
     """One finger's patch: its problem (a point load of ``force`` [N] along ``-normal``), the cut,
@@ -239,17 +250,13 @@ def patch_setups(obj, st, size: float = PATCH_SIZE, analysis: str = "nonlinear",
     """One :class:`PatchProblem` per finger of MuJoCo's settled grasp ``st`` (graspdef.pipeline.grasp
     Settled) on ``obj``'s shell (GraspObject): the patch around the finger's force-weighted mean contact
     point (object frame), loaded by its settled normal force (or ``forces[finger]`` [N])."""
-    size = check_size(size)
+    size = check_object_size(obj.shell, size)
     shell, spec, g = obj.shell, obj.spec, st.g
-    extent = float(np.ptp(shell.rest_positions[: shell.mesh.n_real], axis=0).max())
     lv = default_levels(shell, size) if levels is None else int(levels)
     if lv < 0:
         raise ProblemError(f"patch refinement levels must be >= 0, got {levels!r}")
     xc, fc = refined_control_mesh(shell, lv)
     material = patch_material(spec.material, analysis)
-    if size > extent:
-        raise ProblemError(f"--patch-size {size * 1e3:.3g} mm is larger than the object ({extent * 1e3:.3g} mm "
-                           "across)")
     pf = g.contacts.transformed(g.pose).per_finger()
     out = []
     for s in sorted(pf):
