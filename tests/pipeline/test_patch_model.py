@@ -145,3 +145,24 @@ def test_bad_patches(ball):
     d = (c - xc.mean(axis=0)) / np.linalg.norm(c - xc.mean(axis=0))
     with pytest.raises(ProblemError, match="off the surface"):
         build_patch(xc, fc, LinearElastic(1e6, 0.5), T, c + 0.02 * d, 1.0, PATCH_SIZE)
+
+
+def test_run_grasp_patch_record(tmp_path):
+    """``run_grasp(model="patch")`` end to end (linear, tennis ball, 21.48 N, the default 45 mm): the
+    run folder's record states ``model: patch`` and ``patch_size_m``, holds each finger's patch with its
+    max displacement, and ``derived.max_displacement`` is the larger finger's; the record's border
+    values show the clamp (|u| below 1e-3 of the maximum)."""
+    from graspdef.pipeline.grasp import run_grasp
+    from graspdef.runs import read_run
+
+    run = run_grasp("tennis_ball", 21.48, analysis="linear", out=tmp_path / "run", model="patch")
+    r = read_run(run.out).record
+    assert r["model"] == "patch" and r["patch_size_m"] == PATCH_SIZE
+    assert r["material"]["nu"] == 0.5 and r["gas_p0_Pa"] == 0.0
+    per = {s: p["max_displacement_m"] for s, p in r["patches"].items()}
+    assert set(per) == {"left", "right"}
+    assert r["derived"]["max_displacement"]["value"] == pytest.approx(max(per.values()), rel=1e-12)
+    assert r["derived"]["max_displacement_per_finger"]["value"] == pytest.approx(per)
+    for p in r["patches"].values():
+        assert p["border"]["max_displacement_m"] < 1e-3 * p["max_displacement_m"]
+        assert p["refine_levels"] == 2 and p["size_m"] == PATCH_SIZE
