@@ -363,7 +363,8 @@ def patch_record(obj, st, pps: list, solved: list, force: float, analysis: str, 
         "fingers": fingers, "feedback": feedback, "displacement_reference": reference,
         "mujoco": g.record(), "convergence": conv, "timings_s": timings,
     }
-    data["warnings"] = D.plausibility_warnings(analysis, derived["max_displacement"]["value"], spec.thickness, size)
+    extent = float(np.ptp(obj.shell.rest_positions[: obj.shell.mesh.n_real], axis=0).max())
+    data["warnings"] = D.plausibility_warnings(analysis, derived["max_displacement"]["value"], spec.thickness, extent)
     rec = RunRecord("grasp", spec.body, analysis, dict(SI_UNITS), derived, {}, data)
     contacts = {"frame": "world", "units": {"length": "m", "force": "N"}, "object_pose": g.pose.record(),
                 "contacts": g.contacts.records(), "per_finger": data["mujoco"]["per_finger"]}
