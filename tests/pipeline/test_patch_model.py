@@ -166,3 +166,19 @@ def test_run_grasp_patch_record(tmp_path):
     for p in r["patches"].values():
         assert p["border"]["max_displacement_m"] < 1e-3 * p["max_displacement_m"]
         assert p["refine_levels"] == 2 and p["size_m"] == PATCH_SIZE
+
+
+def test_fit_object_model_patch():
+    """graspdef.fit's ObjectModel with ``model="patch"`` (``graspdef fit --model patch``): its linear
+    prediction of a max-displacement row scales exactly as 1/E through the chain (patches rebuilt per
+    E), and pressure, which the patch model has no air for, is refused in one line."""
+    from graspdef.fit.models import ObjectModel
+    from graspdef.fit.table import MeasuredTable
+
+    table = MeasuredTable(np.array([10.63]), np.array([2.56e-3]), ("max",))
+    with pytest.raises(ProblemError, match="no air"):
+        ObjectModel("tennis_ball", table, ["pressure"], "nonlinear", model="patch")
+    m = ObjectModel("tennis_ball", table, ["E"], "linear", model="patch")
+    y1, y2 = m({"E": 2e6})[0], m({"E": 8e6})[0]
+    assert y1 == pytest.approx(4 * y2, rel=1e-9)
+    assert m.description["model"] == "patch" and m.description["patch_size_m"] == PATCH_SIZE
