@@ -23,6 +23,10 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--start", help="start values with units, e.g. E=2MPa,pressure=50kPa (default: object.toml's)")
     ap.add_argument("--max-iterations", dest="max_iterations", type=int, default=30,
                     help="optimiser iterations (each: one evaluation, and one per parameter for the Jacobian) (30)")
+    ap.add_argument("--model", choices=["full", "patch"], default="full",
+                    help="forward model: full (the whole object, default) or patch (the paper's clamped patch per "
+                         "finger contact, nu = 0.5, no air; graspdef grasp --model patch)")
+    ap.add_argument("--patch-size", default="45mm", help="the patch model's square side (45mm)")
     ap.add_argument("--out", help="folder to write fit.json and data.csv to (a fit folder is replaced)")
 
 
@@ -41,12 +45,17 @@ def run(a: argparse.Namespace) -> int:
 
     from ..fit.run import fit_object
 
+    from ..units import quantity
+
+    model = getattr(a, "model", "full")
+    size = quantity(getattr(a, "patch_size", "45mm"), "length", what="--patch-size") if model == "patch" else 0.045
     r = fit_object(a.scene, a.data, a.params, a.analysis, a.out, a.start, a.max_iterations,
-                   progress=lambda msg: progress(a, msg))
+                   progress=lambda msg: progress(a, msg), model=model, patch_size=size)
     doc = r.to_json()
     state = "converged" if r.converged else "NOT CONVERGED"
     solves = "" if r.n_solves is None else f", {r.n_solves} forward solves"
-    print(f"{doc['model'].get('object', a.scene)}: {a.analysis} shell, point loads; {len(r.table)} rows, "
+    how = "point loads" if model == "full" else f"patch model ({size * 1e3:g} mm, border clamped, nu = 0.5, no air)"
+    print(f"{doc['model'].get('object', a.scene)}: {a.analysis} shell, {how}; {len(r.table)} rows, "
           f"{len(r.names)} parameters; {state} ({r.message}); {r.n_evaluations} evaluations{solves}, "
           f"{r.seconds:.1f} s")
     print(f"{'parameter':<10} {'value':>14} {'std':>14} {'std %':>7} {'start':>14}")

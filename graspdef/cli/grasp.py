@@ -31,6 +31,12 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--gas", choices=["auto", "on", "off"], default="auto",
                     help="enclosed air: auto = object.toml's [gas] (nonlinear only), on (object.toml's [gas] p0; "
                          "an error if it has none), off")
+    ap.add_argument("--model", choices=["full", "patch"], default="full",
+                    help="full: the whole object's shell (default); patch: the paper's model (Tian & Jia 2010, "
+                         "Sec. IX-A): per finger contact a square patch of the surface, border clamped, point load, "
+                         "nu = 0.5, no air")
+    ap.add_argument("--patch-size", default="45mm",
+                    help="the patch model's square side, e.g. 45mm (the paper's; default)")
     ap.add_argument("--E-MPa", dest="E_MPa", type=float,
                     help="override the Young's modulus of object.toml's material law [MPa]")
     ap.add_argument("--out", required=True, help="run folder to write (replaced if it exists)")
@@ -101,8 +107,12 @@ def run(a: argparse.Namespace) -> int:
 
         tips = FingertipChange(None if a.pad_size is None else quantity(a.pad_size, "length", what="--pad-size"),
                                a.tip_material)
+    model = getattr(a, "model", "full")
+    patch_size = 0.045
+    if model == "patch":
+        patch_size = quantity(getattr(a, "patch_size", "45mm"), "length", what="--patch-size")
     run = run_grasp(scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E, progress=bar, fingertips=tips,
-                    friction=getattr(a, "friction", None))
+                    friction=getattr(a, "friction", None), model=model, patch_size=patch_size)
     bar._end()                                           # close an open progress line before the summary
     r = run.result
     d = r["derived"]
@@ -110,6 +120,8 @@ def run(a: argparse.Namespace) -> int:
     conv = r["convergence"]
     stop = "" if conv["completed"] else f" (path stopped at load factor {conv.get('load_factor', 0):.3g})"
     model = "point loads" if r["contact"] == "point" else "geometric contact"
+    if r.get("model") == "patch":
+        model = f"patch model ({r['patch_size_m'] * 1e3:g} mm, border clamped, nu = 0.5, no air)"
     area = f", {d['contact_area']['label']} {d['contact_area']['value'] * 1e6:.1f} mm^2" if "contact_area" in d else ""
     print(f"{r['object']}: {r['analysis']} shell, {model}, {r['force_N']:g} N per finger: {ind['label']} "
           f"{ind['value'] * 1e3:.2f} mm, "

@@ -48,7 +48,8 @@ class ObjectModel:
     holds (a subset of graspdef.fit.PARAMETERS); the others keep object.toml's values."""
 
     def __init__(self, scene, table: MeasuredTable, names, analysis: str = "nonlinear", contact: str = "point",
-                 steps: int | None = None, settings=None, progress: Callable[[str], None] | None = None):
+                 steps: int | None = None, settings=None, progress: Callable[[str], None] | None = None,
+                 model: str = "full", patch_size: float = 0.045):
         from ..objects.build import outer_surface
         from ..pipeline.grasp import check_force, prepare_object, settle
         from ..sim.grasp import GraspSettings
@@ -58,6 +59,15 @@ class ObjectModel:
             raise ProblemError("the fit's forward model uses point loads (--contact point): geometric contact paths "
                                "are not smooth enough in the parameters for finite differences")
         _check_points(table, OBJECT_POINTS)
+        if model not in ("full", "patch"):
+            raise ProblemError(f"model must be 'full' or 'patch', got {model!r}")
+        if model == "patch":
+            from ..pipeline.patch import check_size
+
+            patch_size = check_size(patch_size)
+            if "pressure" in names:
+                raise ProblemError("the patch model has no air (the paper modelled none): pressure cannot be fitted")
+        self.model, self.patch_size = model, patch_size
         self.names, self.table, self.analysis, self.contact = list(names), table, analysis, contact
         if "pressure" in self.names and analysis != "nonlinear":
             raise ProblemError("pressure (the enclosed air) needs --analysis nonlinear (p V = const is nonlinear)")
@@ -70,7 +80,11 @@ class ObjectModel:
         for f in sorted(set(table.force.tolist())):
             check_force(scene, f)                      # the gripper's range, before the shell is built
         say("building the shell from the object's data")
-        self.obj = prepare_object(scene, analysis)
+        self.obj = prepare_object(scene, analysis, gas=False if model == "patch" else None)
+        if model == "patch":
+            from ..pipeline.patch import check_object_size
+
+            check_object_size(self.obj.shell, patch_size)
         spec = self.obj.spec
         self.steps = steps or spec.steps
         self.outer, _ = outer_surface(spec)
@@ -80,7 +94,8 @@ class ObjectModel:
             self.settled[f] = settle(self.obj, f, settings or GraspSettings())
         self.n_solves = 0
         self.description = {"kind": "object grasp chain (graspdef.pipeline.grasp)", "scene": str(self.obj.xml),
-                            "object": spec.body, "analysis": analysis, "contact": contact,
+                            "object": spec.body, "analysis": analysis, "contact": contact, "model": model,
+                            **({"patch_size_m": patch_size} if model == "patch" else {}),
                             "material_law": spec.material.law, "nu": spec.material.nu,
                             "object_values": self.start(), "points": {p: OBJECT_POINTS[p] for p in sorted(set(table.point))},
                             "coupling": "MuJoCo settles each force once (rigid proxy, independent of the parameters); "
@@ -119,6 +134,16 @@ class ObjectModel:
 
         obj = self._object(theta)
         st = self.settled[force]
+        if self.model == "patch":
+            from ..pipeline.patch import patch_record, patch_setups, solve_patch
+
+            pps = patch_setups(obj, st, self.patch_size, self.analysis)
+            solved = []
+            for pp in pps:
+                us, sol = solve_patch(pp, self.analysis, self.steps)
+                solved.append((us[pp.force], sol))
+            self.n_solves += 1
+            return patch_record(obj, st, pps, solved, force, self.analysis, {}).record.to_json()
         setup = shell_problem(obj, st, self.contact)
         solved = solve_shell(setup, self.analysis, self.steps)
         self.n_solves += 1

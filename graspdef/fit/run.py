@@ -35,11 +35,14 @@ def parse_start(text: str | None, names: list) -> dict:
 
 
 def fit_object(scene, data, params: str, analysis: str = "nonlinear", out=None, start: str | None = None,
-               max_iterations: int = 30, progress: Callable[[str], None] | None = None) -> FitResult:
+               max_iterations: int = 30, progress: Callable[[str], None] | None = None, model: str = "full",
+               patch_size: float = 0.045) -> FitResult:
     """Fit ``params`` (``"E,pressure"``) of the object of ``scene`` to the table ``data`` (a CSV
     file, graspdef.fit.table) through its grasp chain (:class:`~graspdef.fit.models.ObjectModel`,
     ``analysis`` linear or nonlinear, point loads).  Start: object.toml's values, or ``start``
-    (``"E=2MPa"``).  ``out``: the folder to write fit.json (and data.csv, the table) to."""
+    (``"E=2MPa"``).  ``out``: the folder to write fit.json (and data.csv, the table) to.  ``model``: "full"
+    (the whole object) or "patch" (the paper's clamped patch per contact, side ``patch_size`` [m];
+    graspdef.pipeline.patch)."""
     from ..runs.folder import atomic_folder, check_output_folder
     from .models import ObjectModel
 
@@ -56,7 +59,7 @@ def fit_object(scene, data, params: str, analysis: str = "nonlinear", out=None, 
     given = parse_start(start, names)
     if out is not None:
         check_output_folder(out, FIT_FILE)
-    model = ObjectModel(scene, table, names, analysis, progress=say)
+    model = ObjectModel(scene, table, names, analysis, progress=say, model=model, patch_size=patch_size)
     theta0 = {**model.start(), **given}
     missing = [n for n in names if n not in theta0]
     if missing:

@@ -377,7 +377,7 @@ def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solve
     if analysis == "linear" and fingertips:
         conv["note"] = "linear shell (rest stiffness K0) with contact: a load path of the nonlinear solver"
     data = {
-        "scene": str(obj.xml), "object": spec.body, "force_N": force, "contact": contact,
+        "scene": str(obj.xml), "object": spec.body, "force_N": force, "contact": contact, "model": "full",
         "material": {"model": spec.material.model(analysis), "E_Pa": spec.material.E, "nu": spec.material.nu,
                      "thickness_m": spec.thickness},
         "thickness_m": spec.thickness, "gas_p0_Pa": obj.p0, "shell": obj.shell_info,
@@ -437,12 +437,14 @@ def write_grasp_run(out, outcome: GraspOutcome, config: dict) -> Path:
 def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonlinear", out=None,
               gas: bool | None = None, settings: GraspSettings = GraspSettings(), control_faces: int | None = None,
               steps: int | None = None, E: float | None = None, progress=None, fingertips=None,
-              friction: float | None = None) -> GraspRun:
+              friction: float | None = None, model: str = "full", patch_size: float = 0.045) -> GraspRun:
     """Run the whole chain for ``scene`` at ``force`` [N] per finger; write the run folder ``out``
     (when given) and return its record (see the stages above for the arguments; ``progress``:
     called with a stage name and, during the path, each converged point's info; ``fingertips``: a
     graspdef.sim.gripper.FingertipChange for this run; ``friction``: the sliding friction coefficient mu of
-    fingertips and object, MuJoCo's and the shell-side term's, None: the scene's)."""
+    fingertips and object, MuJoCo's and the shell-side term's, None: the scene's; ``model``: "full" (the whole
+    object's shell) or "patch" (the paper's model, graspdef.pipeline.patch: a clamped square patch of side
+    ``patch_size`` [m] per finger contact, nu = 0.5, point load, no air))."""
     say = progress or (lambda stage, info=None: None)
     t0 = time.perf_counter()
     if contact not in ("point", "geometric"):
@@ -450,6 +452,18 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
                            f"got {contact!r}")
     if not np.isfinite(force) or force <= 0:
         raise ProblemError(f"force must be a positive number of newtons, got {force!r}")
+    if model not in ("full", "patch"):
+        raise ProblemError(f"model must be 'full' (the whole object) or 'patch' (the paper's clamped patch per "
+                           f"contact), got {model!r}")
+    if model == "patch":
+        from .patch import check_size
+
+        patch_size = check_size(patch_size)
+        if contact != "point":
+            raise ProblemError("the patch model loads each patch by a point load: --contact point only")
+        if gas:
+            raise ProblemError("the patch model has no air inside (the paper modelled none): --gas on is refused")
+        gas = False
     if friction is not None:
         from ..contact.friction import check_mu
 
@@ -457,20 +471,37 @@ def run_grasp(scene, force: float, contact: str = "point", analysis: str = "nonl
     check_force(scene, force, fingertips)     # the gripper's range, before the shell is built
     say("shell")
     obj = prepare_object(scene, analysis, gas, control_faces, E)
+    if model == "patch":
+        from .patch import check_object_size
+
+        check_object_size(obj.shell, patch_size)      # before MuJoCo
     t_shell = time.perf_counter()
     say("mujoco")
     st = settle(obj, force, settings, fingertips, friction)
     t_sim = time.perf_counter()
-    setup = shell_problem(obj, st, contact, friction)
-    say("solve")
-    solved = solve_shell(setup, analysis, steps or obj.spec.steps, progress=lambda info: say("point", info))
-    t_solve = time.perf_counter()
-    timings = {"shell_setup": t_shell - t0, "mujoco": t_sim - t_shell, "solve": t_solve - t_sim}
-    outcome = grasp_record(obj, st, setup, solved, force, contact, analysis, timings)
+    if model == "patch":
+        from .patch import patch_record, patch_setups, solve_patch
+
+        pps = patch_setups(obj, st, patch_size, analysis)
+        say("solve")
+        solved = [solve_patch(pp, analysis, steps or obj.spec.steps, progress=lambda info: say("point", info))
+                  for pp in pps]
+        solved = [(us[pp.force], sol) for pp, (us, sol) in zip(pps, solved)]
+        t_solve = time.perf_counter()
+        timings = {"shell_setup": t_shell - t0, "mujoco": t_sim - t_shell, "solve": t_solve - t_sim}
+        outcome = patch_record(obj, st, pps, solved, force, analysis, timings)
+    else:
+        setup = shell_problem(obj, st, contact, friction)
+        say("solve")
+        solved = solve_shell(setup, analysis, steps or obj.spec.steps, progress=lambda info: say("point", info))
+        t_solve = time.perf_counter()
+        timings = {"shell_setup": t_shell - t0, "mujoco": t_sim - t_shell, "solve": t_solve - t_sim}
+        outcome = grasp_record(obj, st, setup, solved, force, contact, analysis, timings)
     timings["total"] = time.perf_counter() - t0
     if out is not None:
         config = {"scene": str(scene), "force_N": force, "contact": contact, "analysis": analysis, "gas": gas,
-                  "control_faces": control_faces, "steps": steps, "E_Pa": E, "friction": friction, "settings": dict(settings.__dict__),
+                  "control_faces": control_faces, "steps": steps, "E_Pa": E, "friction": friction,
+                  "model": model, "patch_size_m": patch_size if model == "patch" else None, "settings": dict(settings.__dict__),
                   "fingertips": None if fingertips is None else dict(fingertips.__dict__),
                   "object_toml": obj.spec.file.read_text()}
         out = write_grasp_run(out, outcome, config)
