@@ -25,7 +25,7 @@ from graspdef.pipeline import run_grasp
 r = run_grasp(sys.argv[3], 21.48, sys.argv[2], "nonlinear", sys.argv[1]).result
 r["timings_s"]["with_imports"] = time.perf_counter() - t0
 print(json.dumps({"timings": r["timings_s"], "indentation_mm": r["feedback"]["indentation_per_finger_m"] * 1e3,
-                  "completed": r["convergence"]["completed"], "contact_area_m2": r["derived"]["contact_area"]["value"],
+                  "completed": r["convergence"]["completed"], "contact_area_m2": r["derived"].get("contact_area", {}).get("value"),
                   "iterations": r["convergence"].get("newton_iterations"),
                   "factorisations": r["convergence"].get("n_factorisations")}))
 """
