@@ -66,10 +66,12 @@ def test_bad_input_is_one_line(name, tmp_path, capsys):
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_fit_of_the_tennis_balls_E_end_to_end(tmp_path, capsys):
     """Data made by the tennis ball's grasp chain (linear shell, point loads, 10 N per finger) at
     E = 1.5 MPa, fitted from object.toml's 1 MPa: E to 1e-4, converged, fit.json in SI with units,
-    the table copied beside it."""
+    the table copied beside it.
+    Slow (15-26 s on 2 cores): `make test-slow`."""
     from graspdef.fit import ObjectModel, read_table
 
     data = _csv(tmp_path, "force_N,displacement_mm,point\n10,1,finger\n10,1,max\n")

@@ -78,16 +78,18 @@ def test_E_and_pressure_recovered_from_pinch_and_bulge():
 def test_pinch_alone_does_not_separate_E_and_pressure():
     """The same shell and air, only the indentation rows: the fit warns that E and pressure are not
     separately identifiable from these data.  Slow (24 s on a loaded machine): the default suite keeps
-    the linear shell's E-thickness trade-off and the estimator's product test for the warning."""
+    the trade-off warning through the estimator's product test (tests/fit/test_fit_estimate.py)."""
     table = synthetic(("finger",), {"E": TRUE["E"], "pressure": TRUE["pressure"]}, "nonlinear")
     r = _fit(table, ["E", "pressure"], "nonlinear")
     assert any("E and pressure are not separately identifiable" in w for w in r.warnings), r.warnings
     assert r.correlation[0, 1] < -0.95
 
 
+@pytest.mark.slow
 def test_linear_shell_E_and_thickness_trade_off_exactly():
     """Linear shell: displacement = F c(E, t) at every row, so only c is identified; the warning
-    names E and thickness, and the condition number of J^T J is beyond the limit."""
+    names E and thickness, and the condition number of J^T J is beyond the limit.
+    Slow (15-26 s on 2 cores): `make test-slow`."""
     table = synthetic(("finger",), {"E": TRUE["E"], "thickness": TRUE["thickness"]}, "linear")
     r = _fit(table, ["E", "thickness"], "linear")
     assert any("E and thickness are not separately identifiable" in w for w in r.warnings), r.warnings

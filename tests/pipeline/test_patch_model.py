@@ -168,10 +168,12 @@ def test_run_grasp_patch_record(tmp_path):
         assert p["refine_levels"] == 2 and p["size_m"] == PATCH_SIZE
 
 
+@pytest.mark.slow
 def test_fit_object_model_patch():
     """graspdef.fit's ObjectModel with ``model="patch"`` (``graspdef fit --model patch``): its linear
     prediction of a max-displacement row scales exactly as 1/E through the chain (patches rebuilt per
-    E), and pressure, which the patch model has no air for, is refused in one line."""
+    E), and pressure, which the patch model has no air for, is refused in one line.
+    Slow (15-26 s on 2 cores): `make test-slow`."""
     from graspdef.fit.models import ObjectModel
     from graspdef.fit.table import MeasuredTable
 
