@@ -24,6 +24,46 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 
 
+class LeftPatch:
+    """The paper's patch model of the tennis ball (Table I) as a forward model of E: MuJoCo settles
+    the pin grasp once at each of ``forces`` [N] (the rigid proxy does not depend on E); the left
+    finger's patch (side ``size`` [m], ``levels`` Loop refinements, default graspdef.pipeline.patch's)
+    is cut around the contact of the grasp at the largest force; ``displacements(E, analysis, fs)``
+    returns the patch's max displacement [m] at each force of ``fs`` (linear: one solve scaled,
+    exact; nonlinear: one load path landing on every force) and the patch problem."""
+
+    def __init__(self, forces, size: float = 0.045, levels: int | None = None):
+        from graspdef.pipeline.grasp import prepare_object, settle
+        from graspdef.pipeline.patch import default_levels, refined_control_mesh
+
+        self.forces, self.size = [float(f) for f in forces], float(size)
+        obj = prepare_object("tennis_ball", "linear", gas=False)
+        pts = {}
+        for f in self.forces:
+            st = settle(obj, f)
+            pf = st.g.contacts.transformed(st.g.pose).per_finger()
+            pts[f] = (pf["left"]["point"], pf["left"]["normal_force"])
+        top = max(self.forces)
+        self.spread = float(max(np.linalg.norm(pts[f][0] - pts[top][0]) for f in self.forces))
+        self.normal_forces = [float(pts[f][1]) for f in self.forces]
+        self.centre = pts[top][0]
+        self.levels = default_levels(obj.shell, self.size) if levels is None else int(levels)
+        self.xc, self.fc = refined_control_mesh(obj.shell, self.levels)
+        self.spec = obj.spec
+
+    def description(self, analysis: str) -> dict:
+        return {"kind": "patch model (graspdef.pipeline.patch), left finger", "analysis": analysis,
+                "patch_size_m": self.size, "refine_levels": self.levels}
+
+    def displacements(self, E: float, analysis: str, fs):
+        from graspdef.pipeline.patch import build_patch, patch_material, patch_measures, solve_patch
+
+        mat = patch_material(self.spec.material.with_E(E), analysis)
+        pp = build_patch(self.xc, self.fc, mat, self.spec.thickness, self.centre, 1.0, self.size, "left", self.levels)
+        us, _ = solve_patch(pp, analysis, steps=4, forces=fs)
+        return np.array([patch_measures(pp, us[f], border=False)["max_displacement_m"] for f in fs]), pp
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--levels", type=int, default=None,
@@ -38,49 +78,34 @@ def main() -> int:
     from graspdef.errors import GraspdefError
     from graspdef.fit.estimate import fit
     from graspdef.fit.table import MeasuredTable, read_table
-    from graspdef.pipeline.grasp import prepare_object, settle
-    from graspdef.pipeline.patch import build_patch, default_levels, patch_material, patch_measures, refined_control_mesh, solve_patch
     from graspdef.units import quantity
 
     size = quantity(a.size, "length", what="--size")
     table = read_table(ROOT / "scenes" / "tennis_ball" / "table1_tian_jia_2010.csv")
     forces = table.force.tolist()
     t0 = time.perf_counter()
-    obj = prepare_object("tennis_ball", "linear", gas=False)
-    pts = {}
-    for f in forces:
-        st = settle(obj, f)
-        pf = st.g.contacts.transformed(st.g.pose).per_finger()
-        pts[f] = (pf["left"]["point"], pf["left"]["normal_force"])
-    spread = max(np.linalg.norm(pts[f][0] - pts[forces[-1]][0]) for f in forces)
-    centre = pts[forces[-1]][0]
-    if a.levels is None:
-        a.levels = default_levels(obj.shell, size)
-    xc, fc = refined_control_mesh(obj.shell, a.levels)
-    print(f"MuJoCo: 4 settles in {time.perf_counter() - t0:.1f} s; left contact spread {spread * 1e3:.2f} mm; "
-          f"settled normal forces {[round(pts[f][1], 3) for f in forces]} N")
-    spec = obj.spec
+    lp = LeftPatch(forces, size, a.levels)
+    a.levels = lp.levels
+    print(f"MuJoCo: 4 settles in {time.perf_counter() - t0:.1f} s; left contact spread {lp.spread * 1e3:.2f} mm; "
+          f"settled normal forces {[round(v, 3) for v in lp.normal_forces]} N")
+    spec = lp.spec
     out: dict = {"table": {"force_N": forces, "measured_max_displacement_m": table.displacement.tolist(),
                            "paper_average_shape_error_m": {"nonlinear": [0.31e-3, 0.62e-3, 0.81e-3, 0.65e-3],
                                                            "linear": [0.30e-3, 0.85e-3, 2.0e-3, 2.37e-3]}},
                  "patch_size_m": size, "refine_levels": a.levels, "thickness_m": spec.thickness, "nu": 0.5,
-                 "contact_spread_m": float(spread), "models": {}}
+                 "contact_spread_m": float(lp.spread), "models": {}}
 
     class PatchModel:
         def __init__(self, analysis, rows):
             self.analysis, self.rows = analysis, rows
             self.n_solves = 0
-            self.description = {"kind": "patch model (graspdef.pipeline.patch), left finger", "analysis": analysis,
-                                "patch_size_m": size, "refine_levels": a.levels}
+            self.description = lp.description(analysis)
             self.seconds = []
 
         def displacements(self, theta, fs):
             t = time.perf_counter()
-            mat = patch_material(spec.material.with_E(theta["E"]), self.analysis)
-            pp = build_patch(xc, fc, mat, spec.thickness, centre, 1.0, size, "left", a.levels)
-            us, _ = solve_patch(pp, self.analysis, steps=4, forces=fs)
+            y, pp = lp.displacements(theta["E"], self.analysis, fs)
             self.n_solves += 1
-            y = np.array([patch_measures(pp, us[f], border=False)["max_displacement_m"] for f in fs])
             self.seconds.append(time.perf_counter() - t)
             return y, pp
 
