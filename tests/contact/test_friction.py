@@ -255,3 +255,28 @@ def test_soda_can_held_or_slips_out_in_mujoco(mu, held):
     assert sum(float(pf[s]["force"] @ up) for s in pf) == pytest.approx(weight, rel=0.05)
     assert all(pf[s]["friction_force"] <= mu * pf[s]["normal_force"] * 1.01 for s in pf)
     assert sum(pf[s]["friction_force"] for s in pf) <= mu * sum(pf[s]["normal_force"] for s in pf) * 1.01
+
+
+@pytest.mark.parametrize("mu, held", [(0.5, True), (0.0, False)])
+def test_duck_held_at_the_papers_force(mu, held):
+    """Tian & Jia 2010, Fig. 14: the rubber duck grasped antipodally with 19.22 N per finger.  In
+    MuJoCo's settle step (gravity ramped in, the duck free) two pins carry at most 2 mu N of
+    tangential force: with mu = 0.5 (rubber on a steel pin is higher) that is 19 N, about 70 times
+    the 27.3 g duck's weight (scenes/duck), so it is held -- its contact forces' vertical parts carry m g (5 %) and each
+    finger's friction stays inside its cone; with mu = 0 it slips out (one line)."""
+    pytest.importorskip("mujoco")
+    from graspdef.sim.grasp import grasp
+    from graspdef.sim.scene import SimError
+
+    if not held:
+        with pytest.raises(SimError, match="slipped out"):
+            grasp("scenes/duck/scene.xml", 19.22, "duck", friction=mu)
+        return
+    g = grasp("scenes/duck/scene.xml", 19.22, "duck", friction=mu)
+    pf = g.per_finger()
+    assert set(pf) == {"left", "right"}
+    assert all(pf[s]["normal_force"] == pytest.approx(19.22, rel=0.01) for s in pf)
+    up = -np.asarray(g.gravity) / np.linalg.norm(g.gravity)
+    weight = g.object_mass * np.linalg.norm(g.gravity)
+    assert sum(float(pf[s]["force"] @ up) for s in pf) == pytest.approx(weight, rel=0.05)
+    assert all(pf[s]["friction_force"] <= mu * pf[s]["normal_force"] * 1.01 for s in pf)
