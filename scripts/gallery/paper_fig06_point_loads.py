@@ -18,6 +18,11 @@ meter").
   approach Reissner's point-load value sqrt(3 (1 - nu^2)) P R / (4 E t^2) = 0.4131 (the edge is
   > 15 bending lengths away).
 
+seed_readings.py tries the other readings of the garbled table (saddle: clamped, shear-diaphragm,
+roller and corner-held edges, height coefficient 500 / 50000, "286" read as 28.6 / 2.86 / 286;
+ellipsoid: five choices of semi-axes and the flat-plate bound): none reproduces 28.6 or 34.3
+(issue 16 item 5).
+
 Full mode: saddle 40 x 40 and 80 x 80 cells, ellipsoid 32 rings; fast mode: saddle 16 x 16,
 ellipsoid 16 rings.
 

@@ -10,7 +10,10 @@ Reproduced: the edge-couple limit load (3.372 vs 3.363, +0.3 %).  Not reproduced
 edge rotation (our path ends at 2.21 rad where the constitutive relations stop being invertible,
 thesis Ch. 5), the ring-load limit (the ring's position is in a figure missing from the text;
 1.189 with the ring at 30 deg) and the uniform-load limit (0.02107 vs 0.0156; load/support
-definition not recoverable) -- docs/axisym.md.
+definition not recoverable) -- docs/axisym.md.  seed_readings.py computes every reading of the
+ring and uniform loads we tried (ring angle, per radian / total / per length, C1 vs C1 + C2 vs mu;
+load per deformed / undeformed / projected area, follower pressure, hinged or clamped edge, R0 to
+the inner or outer surface): none reproduces 0.958 or 0.0156 (issue 16 item 5).
 
 Full mode: each path runs until it cannot be continued or the load falls below -limit (the ring
 load to full eversion).  Fast mode: each path stops shortly after its limit point (load below
