@@ -117,3 +117,20 @@ def test_disk_256gon_edge_2_5_solves():
     w, sol = centre_deflection(pr)
     assert sol.kkt.n_negative in (None, len(sol.kkt.multipliers))
     assert abs(w - 27.038) < 0.01, w
+
+
+def test_disk_geometry_converges_to_timoshenko():
+    """``geometry.disk`` (the boundary moved onto the circle at every refinement), radius 50 from
+    edge length 10: measured -3.142, -1.369, -0.564, -0.265 % at refinements 0, 1, 2, 3 (142, 533,
+    2,065, 8,129 vertices; observed order 1.20, 1.28, 1.09; first-order extrapolation of r = 2, 3:
+    27.583, +0.05 %).  Asserted: r = 0, 1
+    within +-0.1 % of their measured errors, the error falling by more than 1.8 and the
+    first-order extrapolation 2 w_1 - w_0 within 1 % of 27.57."""
+    from graspdef.geometry.primitives import disk
+
+    w0, _ = centre_deflection(disk_problem(disk(A, 10.0, 0), rim_tol=1e-6))
+    w1, _ = centre_deflection(disk_problem(disk(A, 5.0, 1), rim_tol=1e-6))
+    e0, e1 = (w0 - W_SS) / W_SS, (w1 - W_SS) / W_SS
+    assert -0.0324 < e0 < -0.0304 and -0.0147 < e1 < -0.0127, (e0, e1)
+    assert e0 / e1 > 1.8
+    assert abs((2 * w1 - w0) - W_SS) < 0.01 * W_SS, (w0, w1)
