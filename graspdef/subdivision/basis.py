@@ -166,7 +166,7 @@ def irregular_basis(faces: np.ndarray, vf: sp.csr_matrix, face: int, pts: np.nda
     patches are the same up to the numbering of their vertices (:func:`_canonical_patch`) share
     one local subdivision; the cached arrays are only permuted back to each face's vertices."""
     tri = faces[face]
-    sel = np.unique(np.concatenate([vf[t].indices for t in tri]))
+    sel = np.unique(np.concatenate([vf.indices[vf.indptr[t]:vf.indptr[t + 1]] for t in tri]))
     verts, remap = np.unique(faces[sel], return_inverse=True)
     target = int(np.flatnonzero(sel == face)[0])
     lf = remap.reshape(-1, 3)
