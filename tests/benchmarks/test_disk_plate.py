@@ -6,7 +6,7 @@ simply supported edge) and Sec. 20 (the plate loaded at the centre)):
 
 a = 50, E = 1000, nu = 0.3, t = 1, P = 20: w(0) = 27.57 (clamped: P a^2 / (16 pi D) = 10.86).
 
-Measured (docs in the commit 'disk'; scripts in the tests below), the 64-gon of radius 50 meshed
+Measured (the meshes of the tests below), the 64-gon of radius 50 meshed
 by ``polygon`` at edge length 10 and midpoint-refined r times with the new boundary vertices put
 on the circle:  -2.096 %, -1.007 %, -0.511 % at r = 0, 1, 2 (252, 941, 3,633 vertices): first
 order (observed 1.06, 0.98), and the Richardson extrapolation of r = 1, 2 is 27.570 (0.00 %).
