@@ -15,6 +15,7 @@ from graspdef.geometry.mesh import (
 from graspdef.geometry.primitives import (
     annulus,
     cylinder,
+    disk,
     ellipsoid,
     height_field,
     hemisphere,
@@ -30,6 +31,6 @@ from graspdef.geometry.regions import compile_predicate
 __all__ = [
     "LENGTH_UNITS", "TriMesh", "annulus", "boundary_edges", "boundary_loops", "compile_predicate",
     "cylinder", "edge_face_counts", "ellipsoid", "height_field", "hemisphere", "icosphere",
-    "is_closed", "length_scale", "load_mesh", "monkey_saddle", "polygon", "rectangle", "save_ply", "sphere",
+    "disk", "is_closed", "length_scale", "load_mesh", "monkey_saddle", "polygon", "rectangle", "save_ply", "sphere",
     "square_plate", "unique_edges", "validate_mesh", "vertex_valence",
 ]

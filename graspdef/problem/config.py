@@ -44,6 +44,7 @@ _GEOMETRY = {
     "monkey_saddle": {"half_width", "n", "scale"},
     "annulus": {"r_inner", "r_outer", "n_theta", "n_r", "slit_deg"},
     "polygon": {"outer", "holes", "edge_length", "refinements"},
+    "disk": {"radius", "edge_length", "refinements", "center"},
     "mesh": {"path", "units"},
 }
 _GEOMETRY_OPTIONAL = {"center", "theta0_deg", "theta1_deg", "hole_angle_deg", "scale", "units", "slit_deg", "holes", "refinements"}

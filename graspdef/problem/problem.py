@@ -16,7 +16,7 @@ from .nitsche import NitscheRotation
 #: refused (loads given to 4 digits balance to ~1e-5; MuJoCo's settled grasps to ~1e-6)
 SELF_EQUILIBRIUM_RTOL = 1e-3
 from .terms import DeadLoads, NitscheTerm, RestQuadratic, ShellElastic
-from .supports import RigidModes, check_rigid_modes, constraint_rows, independent_rows
+from .supports import RigidModes, check_rigid_modes, constraint_rows, well_conditioned_rows
 
 
 #: sparse solver back-ends a problem may ask for (graspdef.solve.sparse implements them)
@@ -173,7 +173,6 @@ class Problem:
         in linear and nonlinear solves alike."""
         C, labels, g = constraint_rows(self.shell, self.supports, self.evaluator, self.n_collocation,
                                        with_targets=True)
-        keep = independent_rows(C)
-        C, labels, g = C[keep], [labels[i] for i in keep], g[keep]
+        C, labels, g = well_conditioned_rows(C, labels, g)
         check_rigid_modes(C, self.shell.rest_positions, Kb=self.boundary_stiffness())
         return (C, labels, g) if with_targets else (C, labels)

@@ -20,6 +20,8 @@ from .quadrature import triangle_rule
 from .rules import refine
 
 _MAX_DEPTH = 48
+#: most local patches an ``irregular_basis`` cache holds (cleared when full)
+_CACHE_SIZE = 4096
 
 
 def vertex_faces(faces: np.ndarray, n_vertices: int) -> sp.csr_matrix:
@@ -105,17 +107,88 @@ def _local_eval(faces: np.ndarray, nv: int, target: int, pts: np.ndarray, depth:
     return N, dN, ddN
 
 
-def irregular_basis(faces: np.ndarray, vf: sp.csr_matrix, face: int, pts: np.ndarray):
+def _canonical_patch(lf: np.ndarray, target: int) -> tuple[tuple, np.ndarray]:
+    """A numbering of a local patch that depends on its connectivity only.
+
+    Breadth-first over the faces of ``lf`` (k, 3) from face ``target`` across shared edges, each
+    face entered through the edge it shares with the face it is reached from; vertices are
+    numbered as they first appear.  Returns (key: the renumbered faces in visiting order, each
+    starting at its entry edge -- equal keys mean the same patch up to renumbering;
+    order: local vertex index of each new number).  Faces not reached are appended as they are."""
+    nf = len(lf)
+    across = {}
+    for fi in range(nf):
+        a, b, c = (int(v) for v in lf[fi])
+        across[(a, b)] = fi
+        across[(b, c)] = fi
+        across[(c, a)] = fi
+    label: dict[int, int] = {}
+    seen = np.zeros(nf, bool)
+    key = []
+    queue = [(target, tuple(int(v) for v in lf[target]))]
+    seen[target] = True
+    head = 0
+    while head < len(queue):
+        fi, tri = queue[head]
+        head += 1
+        for v in tri:
+            if v not in label:
+                label[v] = len(label)
+        key.append(tuple(label[v] for v in tri))
+        for e in range(3):
+            a, b = tri[e], tri[(e + 1) % 3]
+            g = across.get((b, a))
+            if g is not None and not seen[g]:
+                seen[g] = True
+                t = [int(v) for v in lf[g]]
+                r = t.index(b)
+                queue.append((g, (t[r], t[(r + 1) % 3], t[(r + 2) % 3])))
+    for fi in np.flatnonzero(~seen):              # not edge-connected (not expected): as it is
+        for v in lf[fi]:
+            if int(v) not in label:
+                label[int(v)] = len(label)
+        key.append(tuple(label[int(v)] for v in lf[fi]))
+    order = np.empty(len(label), np.int64)
+    for v, k in label.items():
+        order[k] = v
+    return tuple(key), order
+
+
+def irregular_basis(faces: np.ndarray, vf: sp.csr_matrix, face: int, pts: np.ndarray,
+                    cache: dict | None = None):
     """Exact basis of one face with extraordinary vertices at chart points ``pts`` (q, 2).
 
     Returns (stencil (S,), N (q, S), dN (q, S, 2), ddN (q, S, 3)); the stencil is the union of the
-    one-rings of the face's vertices."""
+    one-rings of the face's vertices, in increasing order.
+
+    ``cache``: a dict shared between calls.  The basis depends only on the connectivity of the
+    local patch (the faces around the face's three vertices) and on ``pts``, so faces whose
+    patches are the same up to the numbering of their vertices (:func:`_canonical_patch`) share
+    one local subdivision; the cached arrays are only permuted back to each face's vertices."""
     tri = faces[face]
-    sel = np.unique(np.concatenate([vf[t].indices for t in tri]))
+    sel = np.unique(np.concatenate([vf.indices[vf.indptr[t]:vf.indptr[t + 1]] for t in tri]))
     verts, remap = np.unique(faces[sel], return_inverse=True)
     target = int(np.flatnonzero(sel == face)[0])
-    N, dN, ddN = _local_eval(remap.reshape(-1, 3), len(verts), target, np.asarray(pts, float), 0)
-    return verts, N, dN, ddN
+    lf = remap.reshape(-1, 3)
+    pts = np.asarray(pts, float)
+    if cache is None:
+        N, dN, ddN = _local_eval(lf, len(verts), target, pts, 0)
+        return verts, N, dN, ddN
+    key, order = _canonical_patch(lf, target)
+    ck = (key, pts.shape, pts.tobytes())
+    hit = cache.get(ck)
+    if hit is None:
+        canon = np.empty(len(order), np.int64)
+        canon[order] = np.arange(len(order))
+        hit = _local_eval(canon[lf], len(order), target, pts, 0)
+        if len(cache) >= _CACHE_SIZE:
+            cache.clear()
+        cache[ck] = hit
+    N, dN, ddN = hit
+    # canonical number k is local vertex order[k]; return columns in local (= sorted global) order
+    inv = np.empty(len(order), np.int64)
+    inv[order] = np.arange(len(order))
+    return verts, N[:, inv], dN[:, inv], ddN[:, inv]
 
 
 @dataclass(frozen=True)
@@ -183,7 +256,8 @@ def build_basis(faces: np.ndarray, n_control: int, active: np.ndarray | None = N
     irr = act[~reg]
     if len(irr):
         vf = vertex_faces(f, n_control)
-        evals = [irregular_basis(f, vf, int(i), qp) for i in irr]
+        cache: dict = {}                      # faces with the same local patch share one evaluation
+        evals = [irregular_basis(f, vf, int(i), qp, cache) for i in irr]
         smax = max(len(e[0]) for e in evals)
         nq = len(qp)
         st = np.zeros((len(irr), smax), np.int64)

@@ -27,6 +27,7 @@ class SurfaceEvaluator:
         self._vf = vertex_faces(self.faces, self.n_control)
         self._counts = face_counts(self.faces, self.n_control)
         self._inner = interior_mask(self.faces, self.n_control)
+        self._cache: dict = {}          # local patches already evaluated (irregular_basis)
 
     def is_regular(self, faces: np.ndarray) -> np.ndarray:
         """True for faces whose three vertices are interior with valence 6 (box-spline patches)."""
@@ -45,7 +46,7 @@ class SurfaceEvaluator:
         if _is_regular(tri[None], self._counts, self._inner)[0]:
             N, dN, ddN = regular_basis(pts)
             return regular_stencils(self._he, tri[None])[0], N, dN, ddN
-        return irregular_basis(self.faces, self._vf, int(face), pts)
+        return irregular_basis(self.faces, self._vf, int(face), pts, self._cache)
 
     def values(self, face: int, bary: np.ndarray, tol: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
         """Control indices (S,) and weights (S,) of the limit point with barycentric coordinates

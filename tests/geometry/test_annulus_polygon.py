@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from graspdef.errors import ProblemError
-from graspdef.geometry.mesh import boundary_loops, unique_edges, validate_mesh, vertex_valence
+from graspdef.geometry.mesh import boundary_edges, boundary_loops, unique_edges, validate_mesh, vertex_valence
 from graspdef.geometry.primitives import POLYGON_MIN_ANGLE_DEG, annulus, midpoint_refined, polygon
 
 SQUARE = [[0.0, 0.0], [4.0, 0.0], [4.0, 3.0], [0.0, 3.0]]
@@ -192,3 +192,31 @@ def test_polygon_bad_inputs(outer, holes, kwargs, message):
     with pytest.raises(ProblemError, match=message) as err:
         polygon(outer, holes, **kwargs)
     assert "\n" not in str(err.value)
+
+
+def test_disk_boundary_on_the_circle_and_problem_file(tmp_path):
+    """``disk``: every boundary vertex on the circle at every refinement, area -> pi R^2, and the
+    problem-file type."""
+    from graspdef.geometry.primitives import disk
+    from graspdef.problem.config import load_problem
+
+    areas = []
+    for k in range(3):
+        m = disk(2.0, 0.8 / 2 ** k, k, center=(1.0, -1.0))
+        b = np.unique(boundary_edges(m.faces))
+        r = np.hypot(m.vertices[b, 0] - 1.0, m.vertices[b, 1] + 1.0)
+        np.testing.assert_allclose(r, 2.0, rtol=0, atol=1e-12)
+        e1 = m.vertices[m.faces[:, 1]] - m.vertices[m.faces[:, 0]]
+        e2 = m.vertices[m.faces[:, 2]] - m.vertices[m.faces[:, 0]]
+        cz = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+        assert np.all(cz > 0)
+        areas.append(0.5 * cz.sum())
+    err = np.abs(np.array(areas) - np.pi * 4.0)
+    assert err[0] > err[1] > err[2]
+    f = tmp_path / "disk.toml"
+    f.write_text('[units]\nlength = "consistent"\nforce = "consistent"\n[geometry]\ntype = "disk"\nradius = 2.0\nedge_length = 0.4\nrefinements = 1\n'
+                 '[material]\nE = 1000.0\nnu = 0.3\n[shell]\nthickness = 0.1\n'
+                 '[regions]\nrim = "abs(sqrt(x*x + y*y) - 2) < 1e-9"\n'
+                 '[[supports]]\nkind = "simply_supported"\nregion = "rim"\n')
+    pr = load_problem(f).problem
+    assert pr.shell.mesh.boundary_edges.shape[0] > 0
