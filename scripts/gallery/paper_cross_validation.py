@@ -2,7 +2,7 @@
 parameters fitted on some measurements (graspdef.fit.fit), the others predicted and compared.
 
 Tennis ball, Table I (scenes/tennis_ball/table1_tian_jia_2010.csv: the scanned ball's maximum
-displacement at 10.63 / 16.50 / 20.37 / 21.48 N per finger):
+displacement at 10.63 / 16.50 / 20.37 / 21.48 N per finger, measured 2.56 / 6.05 / 9.12 / 10.27 mm):
 * fitted on all four rows (a fit, not a prediction: its residuals), on row 1 with rows 2-4
   predicted, and leave-one-out (fitted on three rows, the fourth predicted; all four ways);
 * four models: the full object with its enclosed air (neo-Hookean, nu = 0.5, E and the air's
@@ -227,7 +227,7 @@ def pins_case(table, fitted: list, say=print) -> dict:
             "summary": summary(recs)}
 
 
-def duck_case(models, say=print) -> dict:
+def duck_case(models, say=print, reused: dict | None = None) -> dict:
     from graspdef.fit.models import ObjectModel, object_point
     from graspdef.fit.table import MeasuredTable
 
@@ -236,6 +236,11 @@ def duck_case(models, say=print) -> dict:
     case = {"case": "rubber duck", "rows": [{"scene": s, "what": w, "force_N": f, "measured_m": d} for s, w, f, d in rows],
             "models": {}}
     linear_E: dict = {}
+    lin = (reused or {}).get("models", {}).get("duck-linear")
+    if lin is not None:                       # a reused run's linear fits: the nonlinear starts
+        for a_, sch in enumerate(lin["schemes"]):
+            if sch["converged"]:
+                linear_E[a_] = sch["parameters"]["E"]
     for analysis in models:
         kind = f"duck-{analysis}"
         clock = C.Timer()
@@ -381,7 +386,8 @@ def main(argv: list[str] | None = None) -> dict:
         ap.add_argument("--duck-analyses", default="linear,nonlinear")
         ap.add_argument("--no-pins", action="store_true", help="skip the rigid pins + friction predictions")
         ap.add_argument("--reuse", default=None, help="a previous run's JSON: with --only, the other case is "
-                                                      "taken from it (its numbers, not recomputed)")
+                                                      "taken from it (its numbers, not recomputed), and the duck's "
+                                                      "analyses not in --duck-analyses")
         ap.add_argument("--readme", default=None, help="a Markdown file whose cross-validation block is replaced")
     a = C.parse(NAME, __doc__, argv, extra)
     clock = C.Timer()
@@ -400,7 +406,10 @@ def main(argv: list[str] | None = None) -> dict:
     if a.only in (None, "tennis_ball"):
         cases.append(tennis_case(models, a.fast, pins=not a.fast and not a.no_pins))
     if a.only in (None, "duck") and not a.fast:
-        cases.append(duck_case(a.duck_analyses.split(",")))
+        duck = duck_case(a.duck_analyses.split(","), reused=reused.get("rubber duck"))
+        if "rubber duck" in reused:           # the analyses not recomputed keep the reused numbers
+            duck["models"] = {**reused["rubber duck"]["models"], **duck["models"]}
+        cases.append(duck)
     elif a.only == "tennis_ball" and "rubber duck" in reused:
         cases.append(reused["rubber duck"])
     rec = {"what": "cross-validated predictions of Tian & Jia 2010's measured grasps", "goal_rel": GOAL,
