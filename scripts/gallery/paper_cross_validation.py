@@ -34,6 +34,8 @@ the point-load model fitted ("rigid pins with friction").
 
 --fast: the tennis ball's full linear model only (what tests/gallery runs).  --readme FILE: the
 tables replace the block between "<!-- cross-validation:begin -->" and "<!-- cross-validation:end -->".
+--from-json FILE: only the tables, figure and README block of a finished run.  --only CASE --reuse
+FILE: recompute one case, take the other from FILE.
 """
 from __future__ import annotations
 
@@ -282,12 +284,32 @@ def duck_case(models, say=print, reused: dict | None = None) -> dict:
 
 
 def summary(recs) -> dict:
-    """Every predicted row's relative error, how many within GOAL, the failed ones."""
-    pred = [r for s in recs for r in s["rows"] if r["role"] == "predicted"]
-    errs = [r["error_rel"] for r in pred if r.get("predicted_m") is not None]
-    return {"predictions": len(pred), "within_goal": sum(abs(e) <= GOAL for e in errs),
-            "failed": sum(r.get("predicted_m") is None for r in pred),
-            "max_abs_error_rel": max((abs(e) for e in errs), default=None)}
+    """Every predicted row's relative error, how many within GOAL, the failed ones; also per kind
+    of scheme (leave-one-out, from row 1, other)."""
+    def count(schemes):
+        pred = [r for s in schemes for r in s["rows"] if r["role"] == "predicted"]
+        errs = [r["error_rel"] for r in pred if r.get("predicted_m") is not None]
+        return {"predictions": len(pred), "within_goal": sum(abs(e) <= GOAL for e in errs),
+                "failed": sum(r.get("predicted_m") is None for r in pred),
+                "max_abs_error_rel": max((abs(e) for e in errs), default=None)}
+
+    out = count(recs)
+    out["leave_one_out"] = count([s for s in recs if s["scheme"].startswith("leave")])
+    out["from_row_1"] = count([s for s in recs if s["scheme"].startswith("row 1")])
+    return out
+
+
+def _summary_text(sm: dict) -> str:
+    def one(c, what):
+        t = f"{what}: {c['within_goal']} of {c['predictions']} within {GOAL * 100:.0f} %"
+        if c["failed"]:
+            t += f" ({c['failed']} path(s) stopped)"
+        if c["max_abs_error_rel"] is not None:
+            t += f", largest error {c['max_abs_error_rel'] * 100:.0f} %"
+        return t
+    parts = [one(sm[k], w) for k, w in (("leave_one_out", "leave-one-out"), ("from_row_1", "from row 1"))
+             if sm.get(k, {}).get("predictions")]
+    return "; ".join(parts) if parts else one(sm, "predictions")
 
 
 def secants(F, d) -> np.ndarray:
@@ -329,20 +351,18 @@ def markdown(rec: dict) -> str:
             lines.append("")
             F = np.asarray(case["force_N"])
             k_meas = secants(F, np.asarray(meas))
-            lines.append("Secant stiffness between rows [N/mm] (F/d at row 1, then ΔF/Δd): measured "
-                         + " / ".join(f"{k:.2f}" for k in k_meas))
+            lines.append("Softening — secant stiffness [N/mm] (F/d at row 1, then ΔF/Δd between rows), measured "
+                         + " / ".join(f"{k:.2f}" for k in k_meas) + "; the all-rows fits:")
+            lines.append("")
             for kind, m in case["models"].items():
                 y = [r.get("predicted_m") for r in m["schemes"][0]["rows"]]
                 if m["schemes"][0]["scheme"].startswith("all") and len(y) == len(F) and None not in y:
-                    lines[-1] += f"; {m['label']}, all-rows fit: " + " / ".join(f"{k:.2f}" for k in secants(F, np.asarray(y)))
-            lines[-1] += "."
+                    lines.append(f"* {m['label']}: " + " / ".join(f"{k:.2f}" for k in secants(F, np.asarray(y))))
+            lines.append("")
+            lines.append("Predictions within 15 %:")
             lines.append("")
             for kind, m in case["models"].items():
-                sm = m["summary"]
-                lines.append(f"* {m['label']}: {sm['within_goal']} of {sm['predictions']} predictions within "
-                             f"{GOAL * 100:.0f} %" + (f", {sm['failed']} failed (path stopped)" if sm["failed"] else "")
-                             + (f"; largest error {sm['max_abs_error_rel'] * 100:.0f} %" if sm["max_abs_error_rel"] is not None else "")
-                             + f" ({m['seconds']:.0f} s).")
+                lines.append(f"* {m['label']}: {_summary_text(summary(m['schemes']))} ({m['seconds']:.0f} s).")
             lines.append("")
         else:
             lines += [f"**{case['case']}** — indentation at the finger [mm] (antipodal: half the approach of the two "
@@ -355,6 +375,12 @@ def markdown(rec: dict) -> str:
                     lines.append(f"| {m['label']} | {s['scheme'].replace('fitted on the ', '')} | "
                                  f"{_params(s['parameters'])} | {_md_cell(fitted[0])} | "
                                  f"{pred[0]['row']}: {_md_cell(pred[0])} |")
+            lines.append("")
+            for kind, m in case["models"].items():
+                sm = summary(m["schemes"])
+                lines.append(f"* {m['label']}: {sm['within_goal']} of {sm['predictions']} predictions within "
+                             f"{GOAL * 100:.0f} %" + (f", {sm['failed']} path(s) stopped" if sm["failed"] else "")
+                             + f" ({m['seconds']:.0f} s).")
             lines.append("")
     return "\n".join(lines).rstrip() + "\n"
 
@@ -385,11 +411,23 @@ def main(argv: list[str] | None = None) -> dict:
                                                        f"{', '.join(TENNIS_MODELS)})")
         ap.add_argument("--duck-analyses", default="linear,nonlinear")
         ap.add_argument("--no-pins", action="store_true", help="skip the rigid pins + friction predictions")
+        ap.add_argument("--from-json", default=None, help="write the tables, figure (and --readme) of a finished "
+                                                          "run's JSON; nothing is computed")
         ap.add_argument("--reuse", default=None, help="a previous run's JSON: with --only, the other case is "
                                                       "taken from it (its numbers, not recomputed), and the duck's "
                                                       "analyses not in --duck-analyses")
         ap.add_argument("--readme", default=None, help="a Markdown file whose cross-validation block is replaced")
     a = C.parse(NAME, __doc__, argv, extra)
+    if a.from_json:                            # the tables, figure and README block of a finished run
+        import json
+
+        rec = json.loads(Path(a.from_json).read_text())
+        text = markdown(rec)
+        print(text)
+        (a.out / f"{NAME}.md").write_text(text)
+        if a.readme:
+            write_readme(Path(a.readme), text)
+        return C.finish(a.out, NAME, rec, figure(rec))
     clock = C.Timer()
     models = ["full-linear"] if a.fast else (a.models.split(",") if a.models else list(TENNIS_MODELS))
     bad = [m for m in models if m not in TENNIS_MODELS]
@@ -446,7 +484,9 @@ def figure(rec: dict):
         lo = [d * 1e3 * (1 - GOAL) for d in case["measured_m"]]
         hi = [d * 1e3 * (1 + GOAL) for d in case["measured_m"]]
         ax.fill_between(F, lo, hi, color="0.85", label="±15 %")
-        ax.set_title(m["label"], fontsize=8)
+        import textwrap
+
+        ax.set_title("\n".join(textwrap.wrap(m["label"].replace(" (at the point-load fit's E, p)", ", at the point-load fit"), 34)), fontsize=8)
         ax.set_xlabel("force per finger [N]")
         ax.grid(alpha=0.3)
     axes[0][0].set_ylabel("max. displacement [mm]")
