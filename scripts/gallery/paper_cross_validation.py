@@ -373,7 +373,8 @@ def markdown(rec: dict) -> str:
                     fitted = [r for r in s["rows"] if r["role"] == "fitted"]
                     pred = [r for r in s["rows"] if r["role"] == "predicted"]
                     lines.append(f"| {m['label']} | {s['scheme'].replace('fitted on the ', '')} | "
-                                 f"{_params(s['parameters'])} | {_md_cell(fitted[0])} | "
+                                 f"{_params(s['parameters'])}{'' if s['converged'] else ' (start; the fit failed)'} | "
+                                 f"{_md_cell(fitted[0])} | "
                                  f"{pred[0]['row']}: {_md_cell(pred[0])} |")
             lines.append("")
             for kind, m in case["models"].items():
