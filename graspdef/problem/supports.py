@@ -309,19 +309,12 @@ def check_rigid_modes(C: sp.csr_matrix, x: np.ndarray, rtol: float = 1e-8, Kb: s
             "Add supports, or RigidModes ('remove_rigid_modes = true') for a body held only by loads.")
 
 
-def independent_rows(C: sp.csr_matrix, rtol: float = 1e-9, dense_row: int = 10_000) -> np.ndarray:
-    """Indices of a maximal linearly independent subset of the rows of C.
-
-    Collocation with more points than the limit curve's spline space has dimensions is exactly
-    rank-deficient, so dependent rows are dropped by a pivoted QR on each connected cluster of
-    rows that share columns.  Rows with more than
-    ``dense_row`` non-zeros (rigid-mode rows) are kept as they are."""
-    from scipy.linalg import qr
+def _row_clusters(C: sp.csr_matrix, dense_row: int):
+    """Rows of C with more than ``dense_row`` non-zeros (rigid-mode rows: kept as they are), and the
+    connected clusters of the other rows (rows sharing columns): per cluster its row indices in C,
+    its columns and its dense block."""
     from scipy.sparse.csgraph import connected_components
 
-    m = C.shape[0]
-    if m == 0:
-        return np.zeros(0, np.int64)
     nnz = np.diff(C.indptr)
     dense = np.flatnonzero(nnz > dense_row)
     sparse_rows = np.flatnonzero(nnz <= dense_row)
@@ -329,16 +322,39 @@ def independent_rows(C: sp.csr_matrix, rtol: float = 1e-9, dense_row: int = 10_0
     P = Cs.copy()
     P.data = np.ones_like(P.data)
     ncomp, label = connected_components(P @ P.T, directed=False)
-    keep = [dense]
+    clusters = []
     for c in range(ncomp):
         rows = np.flatnonzero(label == c)
         sub = Cs[rows]
         cols = np.unique(sub.indices)
-        A = sub[:, cols].toarray()
-        R, piv = qr(A.T, mode="r", pivoting=True)
-        diag = np.abs(np.diag(R))
-        rank = int((diag > rtol * diag[0]).sum()) if len(diag) else 0
-        keep.append(sparse_rows[rows[np.sort(piv[:rank])]])
+        clusters.append((sparse_rows[rows], cols, sub[:, cols].toarray()))
+    return dense, clusters
+
+
+def _rank_qr(A: np.ndarray, rtol: float):
+    """Pivoted QR of A^T: (|diag R|, pivots, numerical rank at ``rtol``)."""
+    from scipy.linalg import qr
+
+    R, piv = qr(A.T, mode="r", pivoting=True)
+    diag = np.abs(np.diag(R))
+    rank = int((diag > rtol * diag[0]).sum()) if len(diag) else 0
+    return diag, piv, rank
+
+
+def independent_rows(C: sp.csr_matrix, rtol: float = 1e-9, dense_row: int = 10_000) -> np.ndarray:
+    """Indices of a maximal linearly independent subset of the rows of C.
+
+    Collocation with more points than the limit curve's spline space has dimensions is exactly
+    rank-deficient, so dependent rows are dropped by a pivoted QR on each connected cluster of
+    rows that share columns.  Rows with more than
+    ``dense_row`` non-zeros (rigid-mode rows) are kept as they are."""
+    if C.shape[0] == 0:
+        return np.zeros(0, np.int64)
+    dense, clusters = _row_clusters(C, dense_row)
+    keep = [dense]
+    for rows, _, A in clusters:
+        _, piv, rank = _rank_qr(A, rtol)
+        keep.append(rows[np.sort(piv[:rank])])
     return np.sort(np.concatenate(keep))
 
 
@@ -398,37 +414,21 @@ def well_conditioned_rows(C: sp.csr_matrix, labels: list, g: np.ndarray, rtol: f
     reactions are reported per row) and well-conditioned clusters keep their rows.
 
     Returns (C csr, labels, g)."""
-    from scipy.linalg import qr
-    from scipy.sparse.csgraph import connected_components
-
     g = np.asarray(g, float)
-    m = C.shape[0]
-    if m == 0:
+    if C.shape[0] == 0:
         return C, list(labels), g
-    nnz = np.diff(C.indptr)
-    dense = np.flatnonzero(nnz > dense_row)
-    sparse_rows = np.flatnonzero(nnz <= dense_row)
-    Cs = C[sparse_rows]
-    P = Cs.copy()
-    P.data = np.ones_like(P.data)
-    ncomp, label = connected_components(P @ P.T, directed=False)
+    dense, clusters = _row_clusters(C, dense_row)
     keep = [dense]
     new_rows, new_cols, new_vals, new_labels = [], [], [], []
-    for c in range(ncomp):
-        rows = np.flatnonzero(label == c)
-        sub = Cs[rows]
-        cols = np.unique(sub.indices)
-        A = sub[:, cols].toarray()
-        R, piv = qr(A.T, mode="r", pivoting=True)
-        diag = np.abs(np.diag(R))
-        rank = int((diag > rtol * diag[0]).sum()) if len(diag) else 0
-        if rank < 2 or diag[0] <= cond_max * diag[rank - 1] or np.any(g[sparse_rows[rows]] != 0.0):
-            keep.append(sparse_rows[rows[np.sort(piv[:rank])]])
+    for rows, cols, A in clusters:
+        diag, piv, rank = _rank_qr(A, rtol)
+        if rank < 2 or diag[0] <= cond_max * diag[rank - 1] or np.any(g[rows] != 0.0):
+            keep.append(rows[np.sort(piv[:rank])])
             continue
-        sel = rows[np.sort(piv[:rank])]
-        local, extra = _rebased(A[np.sort(piv[:rank])], cond_max)
-        keep.append(sparse_rows[sel[local]])
-        names = sorted({str(labels[i]).split(":")[0] for i in sparse_rows[rows]})
+        sel = np.sort(piv[:rank])
+        local, extra = _rebased(A[sel], cond_max)
+        keep.append(rows[sel[local]])
+        names = sorted({str(labels[i]).split(":")[0] for i in rows})
         for k in range(len(extra)):
             nz = np.flatnonzero(extra[k])
             new_rows.append(np.full(len(nz), len(new_labels)))

@@ -235,27 +235,39 @@ def test_soda_can_held_or_slips_out_in_mujoco(mu, held):
     normals lean 2-3 degrees off the grasp axis, so part of each friction force (about 0.03-0.04 N,
     opposite on the two fingers) balances the tangential part of the axial squeeze, and the
     normal forces' own vertical parts carry 17 % of the weight."""
+    g = _grasp_held_or_slips("soda_can", 0.76, mu, held)
+    if g is None:
+        return
+    assert g.object_mass == pytest.approx(SODA_CAN_MASS, rel=1e-3)
+    assert g.object_mass * np.linalg.norm(g.gravity) == pytest.approx(SODA_CAN_MASS * 9.81, rel=1e-3)
+    pf = g.per_finger()
+    assert sum(pf[s]["friction_force"] for s in pf) <= mu * sum(pf[s]["normal_force"] for s in pf) * 1.01
+
+
+def _grasp_held_or_slips(scene: str, force: float, mu: float, held: bool):
+    """MuJoCo's settle of ``scene`` at ``force`` per finger with friction ``mu``: slips out (SimError,
+    one line) or is held -- each finger pushes ``force`` (1 %) with coefficient mu, the contact
+    forces' vertical parts carry m g (5 %) and each finger's friction stays inside its cone.
+    Returns the grasp when held."""
     pytest.importorskip("mujoco")
     from graspdef.sim.grasp import grasp
     from graspdef.sim.scene import SimError
 
+    xml = f"scenes/{scene}/scene.xml"
     if not held:
         with pytest.raises(SimError, match="slipped out"):
-            grasp("scenes/soda_can/scene.xml", 0.76, "soda_can", friction=mu)
-        return
-    g = grasp("scenes/soda_can/scene.xml", 0.76, "soda_can", friction=mu)
+            grasp(xml, force, scene, friction=mu)
+        return None
+    g = grasp(xml, force, scene, friction=mu)
     pf = g.per_finger()
     assert set(pf) == {"left", "right"}
     assert all(pf[s]["friction_coefficient"] == pytest.approx(mu) for s in pf)
-    assert all(pf[s]["normal_force"] == pytest.approx(0.76, rel=0.01) for s in pf)
-    assert g.object_mass == pytest.approx(SODA_CAN_MASS, rel=1e-3)
+    assert all(pf[s]["normal_force"] == pytest.approx(force, rel=0.01) for s in pf)
     up = -np.asarray(g.gravity) / np.linalg.norm(g.gravity)
     weight = g.object_mass * np.linalg.norm(g.gravity)
-    assert weight == pytest.approx(SODA_CAN_MASS * 9.81, rel=1e-3)
     assert sum(float(pf[s]["force"] @ up) for s in pf) == pytest.approx(weight, rel=0.05)
     assert all(pf[s]["friction_force"] <= mu * pf[s]["normal_force"] * 1.01 for s in pf)
-    assert sum(pf[s]["friction_force"] for s in pf) <= mu * sum(pf[s]["normal_force"] for s in pf) * 1.01
-
+    return g
 
 @pytest.mark.parametrize("mu, held", [(0.5, True), (0.0, False)])
 def test_duck_held_at_the_papers_force(mu, held):
@@ -264,19 +276,4 @@ def test_duck_held_at_the_papers_force(mu, held):
     tangential force: with mu = 0.5 (rubber on a steel pin is higher) that is 19 N, about 70 times
     the 27.3 g duck's weight (scenes/duck), so it is held -- its contact forces' vertical parts carry m g (5 %) and each
     finger's friction stays inside its cone; with mu = 0 it slips out (one line)."""
-    pytest.importorskip("mujoco")
-    from graspdef.sim.grasp import grasp
-    from graspdef.sim.scene import SimError
-
-    if not held:
-        with pytest.raises(SimError, match="slipped out"):
-            grasp("scenes/duck/scene.xml", 19.22, "duck", friction=mu)
-        return
-    g = grasp("scenes/duck/scene.xml", 19.22, "duck", friction=mu)
-    pf = g.per_finger()
-    assert set(pf) == {"left", "right"}
-    assert all(pf[s]["normal_force"] == pytest.approx(19.22, rel=0.01) for s in pf)
-    up = -np.asarray(g.gravity) / np.linalg.norm(g.gravity)
-    weight = g.object_mass * np.linalg.norm(g.gravity)
-    assert sum(float(pf[s]["force"] @ up) for s in pf) == pytest.approx(weight, rel=0.05)
-    assert all(pf[s]["friction_force"] <= mu * pf[s]["normal_force"] * 1.01 for s in pf)
+    _grasp_held_or_slips("duck", 19.22, mu, held)
