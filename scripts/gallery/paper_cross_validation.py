@@ -419,6 +419,9 @@ def main(argv: list[str] | None = None) -> dict:
                                                       "analyses not in --duck-analyses")
         ap.add_argument("--readme", default=None, help="a Markdown file whose cross-validation block is replaced")
     a = C.parse(NAME, __doc__, argv, extra)
+    for opt, f in (("--from-json", a.from_json), ("--reuse", a.reuse)):
+        if f and not Path(f).is_file():
+            raise SystemExit(f"{opt}: no such file: {f} (a JSON written by this script)")
     if a.from_json:                            # the tables, figure and README block of a finished run
         import json
 
