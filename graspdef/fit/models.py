@@ -45,11 +45,14 @@ def _check_points(table: MeasuredTable, accepted) -> None:
 
 class ObjectModel:
     """The grasp chain of an object (see the module docstring).  ``names``: the parameters theta
-    holds (a subset of graspdef.fit.PARAMETERS); the others keep object.toml's values."""
+    holds (a subset of graspdef.fit.PARAMETERS); the others keep object.toml's values.  ``gas``:
+    None = object.toml's air (nonlinear only), False = none, True = required; ``control_faces``:
+    a control mesh of that many faces instead of object.toml's (graspdef.pipeline.grasp.prepare_object)."""
 
     def __init__(self, scene, table: MeasuredTable, names, analysis: str = "nonlinear", contact: str = "point",
                  steps: int | None = None, settings=None, progress: Callable[[str], None] | None = None,
-                 model: str = "full", patch_size: float = 0.045):
+                 model: str = "full", patch_size: float = 0.045, gas: bool | None = None,
+                 control_faces: int | None = None):
         from ..objects.build import outer_surface
         from ..pipeline.grasp import check_force, prepare_object, settle
         from ..sim.grasp import GraspSettings
@@ -74,13 +77,15 @@ class ObjectModel:
         from ..objects import load_object
 
         spec = load_object(scene)                     # checked before any heavy work
+        if "pressure" in self.names and gas is False:
+            raise ProblemError("gas off: the object's air is removed, so its pressure cannot be fitted")
         if "pressure" in self.names and spec.gas is None:
             raise ProblemError(f"{spec.file}: no [gas] table: the object has no enclosed air whose pressure could "
                                "be fitted")
         for f in sorted(set(table.force.tolist())):
             check_force(scene, f)                      # the gripper's range, before the shell is built
         say("building the shell from the object's data")
-        self.obj = prepare_object(scene, analysis, gas=False if model == "patch" else None)
+        self.obj = prepare_object(scene, analysis, gas=False if model == "patch" else gas, control_faces=control_faces)
         if model == "patch":
             from ..pipeline.patch import check_object_size
 

@@ -53,3 +53,21 @@ def test_air_pressure_enters_the_nonlinear_chain():
     stiff = m({"pressure": 80e3})[0]
     print(f"\nindentation at 10 N: {soft * 1e3:.3f} mm (20 kPa), {stiff * 1e3:.3f} mm (80 kPa)")
     assert soft > 1.2 * stiff > 0
+
+
+def test_gas_off_removes_the_air():
+    """gas=False (the paper's model: no air): the record holds no air and the ball indents far more
+    at 2 N per finger than with object.toml's 80 kPa (1 MPa wall: without air, its pole inverts
+    below 3.8 N); fitting a pressure without air is refused before any solve."""
+    from graspdef.errors import ProblemError
+
+    table = MeasuredTable(np.array([2.0]), np.zeros(1), ("finger",))
+    off = ObjectModel("tennis_ball", table, ["E"], "nonlinear", gas=False)
+    on = ObjectModel("tennis_ball", table, ["E"], "nonlinear")
+    r_off, r_on = off.record({"E": 1e6}, 2.0), on.record({"E": 1e6}, 2.0)
+    assert r_off["gas_p0_Pa"] == 0 and r_on["gas_p0_Pa"] == 80e3
+    a, b = (r["derived"]["indentation_per_finger"]["value"] for r in (r_off, r_on))
+    print(f"\n2 N, 1 MPa: {a * 1e3:.3f} mm without air, {b * 1e3:.3f} mm with 80 kPa")
+    assert a > 3 * b > 0
+    with pytest.raises(ProblemError, match="gas off"):
+        ObjectModel("tennis_ball", table, ["E", "pressure"], "nonlinear", gas=False)
