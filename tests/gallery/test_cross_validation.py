@@ -85,3 +85,25 @@ def test_fast_mode_linear_ball_obeys_the_closed_form(tmp_path):
         train = [k - 1 for k in s["fitted_rows"]]
         assert s["parameters"]["E"] == pytest.approx(_closed_form_E(c, MEASURED, train), rel=1e-4), s["scheme"]
     assert (tmp_path / "paper_cross_validation.md").read_text().count("|") > 20
+
+
+def test_a_start_whose_path_stops_is_doubled_until_the_path_runs():
+    """The duck's nonlinear fit starts from the linear fit's E; a load path that stops there (too
+    soft: a limit point before the force) is no start, so E doubles until the path reaches the
+    force; every stopped start is listed with its reason; when no start runs, the original is
+    returned and all tries are listed."""
+    import paper_cross_validation as X
+    from graspdef.errors import SolverError
+
+    def per_force(th, f):
+        if th["E"] < 100e6:
+            raise SolverError(f"the load path stopped at {th['E'] * 1e-8:.2f}")
+        return f / th["E"]
+
+    fw = X.Forward([19.22], per_force=per_force)
+    start, stopped = X.running_start(fw, {"E": 30e6}, 19.22)
+    assert start == {"E": 120e6}
+    assert [t["E"] for t in stopped] == [30e6, 60e6] and "stopped" in stopped[0]["failure"]
+    start, stopped = X.running_start(fw, {"E": 1e6}, 19.22, tries=3)
+    assert start == {"E": 1e6} and [t["E"] for t in stopped] == [1e6, 2e6, 4e6, 8e6]
+    assert X.running_start(fw, {"E": 2e8}, 19.22) == ({"E": 2e8}, [])
