@@ -135,6 +135,26 @@ class ObjectModel:
     def record(self, theta: dict, force: float) -> dict:
         """The grasp record (result.json's document) at ``theta`` and ``force`` [N]; a load path
         that stops raises SolverError."""
+        return self.outcome(theta, force).record.to_json()
+
+    def surface(self, theta: dict, force: float, side: str = "mid"):
+        """The deformed limit surface at ``theta`` and ``force`` [N] (the object's frame, rigid motion
+        of a free body removed; a TriMesh [m]): ``side`` "mid" (deformed.ply of the run) or "outer"
+        (moved by half of theta's thickness along its outward normals: what a scanner sees)."""
+        from ..geometry import TriMesh
+
+        if side not in ("mid", "outer"):
+            raise ProblemError(f"side must be 'mid' or 'outer', got {side!r}")
+        o = self.outcome(theta, force)
+        mesh = TriMesh(o.deformed, o.faces)
+        if side == "outer":
+            from .scan import outer
+
+            mesh = outer(mesh, 0.5 * float(theta.get("thickness", self.obj.spec.thickness)))
+        return mesh
+
+    def outcome(self, theta: dict, force: float):
+        """graspdef.pipeline.grasp.GraspOutcome (record and surfaces) at ``theta`` and ``force``."""
         from ..pipeline.grasp import grasp_record, shell_problem, solve_shell
 
         obj = self._object(theta)
@@ -148,13 +168,13 @@ class ObjectModel:
                 us, sol = solve_patch(pp, self.analysis, self.steps)
                 solved.append((us[pp.force], sol))
             self.n_solves += 1
-            return patch_record(obj, st, pps, solved, force, self.analysis, {}).record.to_json()
+            return patch_record(obj, st, pps, solved, force, self.analysis, {})
         setup = shell_problem(obj, st, self.contact)
         solved = solve_shell(setup, self.analysis, self.steps)
         self.n_solves += 1
         if not solved.completed:
             raise SolverError(f"at {force:g} N the load path stopped: {solved.stop_reason}")
-        return grasp_record(obj, st, setup, solved, force, self.contact, self.analysis, {}).record.to_json()
+        return grasp_record(obj, st, setup, solved, force, self.contact, self.analysis, {})
 
     def __call__(self, theta: dict) -> np.ndarray:
         out = np.empty(len(self.table))

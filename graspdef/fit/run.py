@@ -8,6 +8,8 @@ import shutil
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
+
 from ..errors import ProblemError
 from ..units import quantity
 from .estimate import PARAMETERS, FitResult, fit, parse_names
@@ -83,3 +85,70 @@ def _unit(name: str) -> float:
 
     p = PARAMETERS[name]
     return unit_factor(p.display, p.dimension)
+
+
+def fit_object_scan(scene, scan, force: float, params: str, analysis: str = "nonlinear", out=None,
+                    start: str | None = None, max_iterations: int = 30, scan_units: str | None = None,
+                    near: float = 0.02, sigma: float | None = None, progress: Callable[[str], None] | None = None,
+                    model: str = "full", patch_size: float = 0.045, passes: int = 2) -> FitResult:
+    """Fit ``params`` of the object of ``scene`` to a deformed scan (a mesh file, ``scan_units`` if
+    it states none) taken at ``force`` [N] per finger (graspdef.fit.scan: registered onto the
+    predicted outer surface, the points within ``near`` [m] of the load points kept, their signed
+    distances fitted; ``sigma`` [m]: the scan's noise).  ``out``: the folder for fit.json."""
+    from ..registration.score import read_scan
+    from ..runs.folder import atomic_folder, check_output_folder
+    from .models import ObjectModel
+    from .scan import fit_scan
+    from .table import MeasuredTable
+
+    say = progress or (lambda msg: None)
+    if analysis not in ("linear", "nonlinear"):
+        raise ProblemError(f"analysis must be 'linear' or 'nonlinear', got {analysis!r}")
+    if not (isinstance(max_iterations, int) and max_iterations >= 1):
+        raise ProblemError(f"--max-iterations must be a positive integer, got {max_iterations!r}")
+    if not (isinstance(force, (int, float)) and force > 0):
+        raise ProblemError(f"--force must be a positive force (the scan's force per finger), got {force!r}")
+    names = parse_names(params)
+    given = parse_start(start, names)
+    points = read_scan(scan, scan_units)
+    if out is not None:
+        check_output_folder(out, FIT_FILE)
+    om = ObjectModel(scene, MeasuredTable(np.array([float(force)]), np.zeros(1), ("finger",)), names, analysis, progress=say,
+                     model=model, patch_size=patch_size)
+    theta0 = {**om.start(), **given}
+    missing = [n for n in names if n not in theta0]
+    if missing:
+        raise ProblemError(f"no start value for {', '.join(missing)}: give --start")
+    theta0 = {n: theta0[n] for n in names}
+    memo: dict = {}
+
+    def outcome(theta):
+        key = tuple(sorted(theta.items()))
+        if key not in memo:
+            memo.clear()
+            memo[key] = om.outcome(theta, float(force))
+        return memo[key]
+
+    def surface(theta):
+        from ..geometry import TriMesh
+        from .scan import outer
+
+        o = outcome(theta)
+        return outer(TriMesh(o.deformed, o.faces), 0.5 * float(theta.get("thickness", om.obj.spec.thickness)))
+
+    say(f"solving at the start values for the load points ({len(points)} scan points)")
+    rec = outcome(theta0).record.to_json()
+    loads = [f["load_point_m"] for f in rec["fingers"].values()]
+
+    def step(info):
+        th = ", ".join(f"{k} {v / _unit(k):.5g} {PARAMETERS[k].display}" for k, v in info["theta"].items())
+        say(f"evaluation {info['evaluations']}: {th}: RMS distance {info['rms_m'] * 1e3:.4g} mm")
+
+    result, sels = fit_scan(surface, points, loads, float(force), theta0, near=near, sigma=sigma, passes=passes,
+                            max_nfev=max_iterations, progress=step)
+    result.model.update({k: v for k, v in om.description.items() if k not in result.model})
+    result.model["scan_file"] = str(scan)
+    if out is not None:
+        with atomic_folder(out) as tmp:
+            (Path(tmp) / FIT_FILE).write_text(json.dumps(result.to_json(), indent=2) + "\n")
+    return result

@@ -157,6 +157,19 @@ def _read(path: Path, declared: str | None, what: str) -> tuple[np.ndarray, np.n
     return vertices, faces, units
 
 
+def read_scan(path: str | PathLike, units: str | None = None) -> np.ndarray:
+    """A scan's points [m] (the vertices of a PLY/OBJ/STL file); ``units``: the file's length unit
+    when it states none ("mm", ...), or a known real scan's id (scans/manifest.toml).
+    RegistrationError: a missing file, no units, a unit conflict."""
+    path = Path(path)
+    if not path.exists() and str(path) in load_manifest().real:
+        entry = load_manifest().real[str(path)]
+        path, units = entry.file(), units or entry.units
+    if not path.is_file():
+        raise RegistrationError(f"scan {path}: no such file")
+    return _read(path, units, "scan")[0]
+
+
 def score_cli(prediction_path: str | PathLike, scan_path: str | PathLike,
               out_dir: str | PathLike, *, undeformed_path: str | PathLike | None = None,
               prediction_units: str | None = None, scan_units: str | None = None,
