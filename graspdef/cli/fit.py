@@ -1,4 +1,4 @@
-"""``graspdef fit OBJECT --data TABLE.csv --params E[,pressure,thickness] [--analysis ...] [--out DIR]``."""
+"""``graspdef fit OBJECT --data TABLE.csv | --scan SCAN --force F  --params E[,pressure,thickness] [--analysis ...] [--out DIR]``."""
 from __future__ import annotations
 
 import argparse
@@ -10,7 +10,9 @@ DESCRIPTION = ("Identify material parameters of an object from a measured force-
                "log-parameters through the object's grasp chain (MuJoCo once per force, the shell per "
                "evaluation), finite-difference sensitivities. Prints the fitted values with standard errors, "
                "the residual of every row, the correlations, and a warning when parameters trade off; writes "
-               "fit.json (SI) to --out. Exit status 1 when the fit does not converge. docs/fit.md.")
+               "fit.json (SI) to --out. Or from a scan of the deformed object (--scan FILE --force F): its points "
+               "near the load points fitted by their distances to the predicted outer surface after registration. "
+               "Exit status 1 when the fit does not converge. docs/fit.md.")
 
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:

@@ -4,6 +4,7 @@ table)."""
 from __future__ import annotations
 
 import json
+import math
 import shutil
 from pathlib import Path
 from typing import Callable
@@ -108,6 +109,10 @@ def fit_object_scan(scene, scan, force: float, params: str, analysis: str = "non
         raise ProblemError(f"--max-iterations must be a positive integer, got {max_iterations!r}")
     if not (isinstance(force, (int, float)) and force > 0):
         raise ProblemError(f"--force must be a positive force (the scan's force per finger), got {force!r}")
+    if sigma is not None and not (isinstance(sigma, (int, float)) and math.isfinite(sigma) and sigma > 0):
+        raise ProblemError(f"--scan-sigma must be a positive length, got {sigma!r} m")
+    if not (isinstance(near, (int, float)) and math.isfinite(near) and near > 0):
+        raise ProblemError(f"--near must be a positive length, got {near!r} m")
     names = parse_names(params)
     given = parse_start(start, names)
     points = read_scan(scan, scan_units)

@@ -32,6 +32,9 @@ from .table import MeasuredTable
 
 #: the point label of a scan observation in a table
 SCAN_POINT = "scan"
+#: the overlap (fraction of scan points near the surface) the first registration pass accepts: its
+#: target, the prediction at the start values, may be far from the scan
+FIRST_PASS_MIN_FITNESS = 0.2
 
 
 def outer(mesh: TriMesh, offset: float) -> TriMesh:
@@ -72,7 +75,7 @@ def check_scan(points) -> np.ndarray:
 
 
 def prepare_scan(points, target: TriMesh | None, load_points, *, near: float, max_points: int = 800,
-                 seed: int = 0, init="pca") -> ScanSelection:
+                 seed: int = 0, init="pca", min_fitness: float = 0.5) -> ScanSelection:
     """Register the scan ``points`` (n, 3) [m] onto ``target`` (a predicted outer surface, object
     frame; None: the scan is already in the object's frame) and keep the points within ``near`` [m]
     of a load point (see the module docstring).  Bad input: ProblemError, one line."""
@@ -86,7 +89,7 @@ def prepare_scan(points, target: TriMesh | None, load_points, *, near: float, ma
     if target is not None:
         from ..registration.icp import apply, register
 
-        r = register(pts, target, init=init)
+        r = register(pts, target, init=init, min_fitness=min_fitness)
         T = r.transform
         reg = {"fitness": r.fitness, "converged": r.converged, "init": r.init, "flags": list(r.flags)}
         pts = apply(T, pts)
@@ -148,9 +151,14 @@ def fit_scan(surface: Callable[[dict], TriMesh], points, load_points, force: flo
     theta, sels, res = dict(start), [], None
     if register is False:
         passes = 1
-    for _ in range(passes):
+    if sigma is not None and not (np.isfinite(sigma) and sigma > 0):
+        raise ProblemError(f"the scan's sigma must be a positive length, got {sigma!r} m")
+    for k in range(passes):
         target = outer(surface(theta), offset) if register else None
-        sel = prepare_scan(pts, target, load_points, near=near, max_points=max_points, seed=seed, init=init)
+        # the first pass registers onto the start's prediction, which may be far off (dents three
+        # times too deep): it accepts a smaller overlap; the last pass needs the usual 50 %
+        sel = prepare_scan(pts, target, load_points, near=near, max_points=max_points, seed=seed, init=init,
+                           min_fitness=FIRST_PASS_MIN_FITNESS if k < passes - 1 else 0.5)
         sels.append(sel)
         model = ScanModel(surface, sel, offset)
         res = fit(model, scan_table(sel, force, sigma), theta, max_nfev=max_nfev, progress=progress)
