@@ -49,9 +49,17 @@ def _si(name: str, value: float) -> str:
     return f"{value / unit_factor(p.display, p.dimension):.5g} {p.display}"
 
 
-def run(a: argparse.Namespace) -> int:
+def _print_parameters(r) -> None:
+    """The fitted values with their standard errors and starts, one line each."""
     import math
 
+    print(f"{'parameter':<10} {'value':>14} {'std':>14} {'std %':>7} {'start':>14}")
+    for n, v, s, s0 in zip(r.names, r.values, r.std, r.start):
+        rel = f"{100 * s / v:7.2f}" if math.isfinite(s) and s < 1e3 * v else "    inf"
+        print(f"{n:<10} {_si(n, v):>14} {_si(n, s) if math.isfinite(s) else 'n/a':>14} {rel} {_si(n, s0):>14}")
+
+
+def run(a: argparse.Namespace) -> int:
     import numpy as np
 
     from ..fit.run import fit_object
@@ -90,10 +98,7 @@ def run(a: argparse.Namespace) -> int:
     print(f"{doc['model'].get('object', a.scene)}: {a.analysis} shell, {how}; {len(r.table)} rows, "
           f"{len(r.names)} parameters; {state} ({r.message}); {r.n_evaluations} evaluations{solves}, "
           f"{r.seconds:.1f} s")
-    print(f"{'parameter':<10} {'value':>14} {'std':>14} {'std %':>7} {'start':>14}")
-    for n, v, s, s0 in zip(r.names, r.values, r.std, r.start):
-        rel = f"{100 * s / v:7.2f}" if math.isfinite(s) and s < 1e3 * v else "    inf"
-        print(f"{n:<10} {_si(n, v):>14} {_si(n, s) if math.isfinite(s) else 'n/a':>14} {rel} {_si(n, s0):>14}")
+    _print_parameters(r)
     print(f"{'force N':>8} {'point':<8} {'measured mm':>11} {'predicted mm':>12} {'residual mm':>11} {'res/sigma':>9}")
     for row in doc["rows"]:
         def mm(x):
@@ -115,8 +120,6 @@ def run(a: argparse.Namespace) -> int:
 
 def _print_scan(a, r) -> int:
     """The scan fit's summary: the parameters and the distances (one row per scan point is in fit.json)."""
-    import math
-
     import numpy as np
 
     from ._common import warn
@@ -127,10 +130,7 @@ def _print_scan(a, r) -> int:
     print(f"{m.get('object', a.scene)}: {a.analysis} shell, deformed scan {m.get('scan_file')} at "
           f"{m.get('force_N', float('nan')):g} N; {len(r.table)} scan points within {passes[-1]['near_m'] * 1e3:g} mm of "
           f"the load points; {state} ({r.message}); {len(passes)} registration pass(es), {r.seconds:.1f} s")
-    print(f"{'parameter':<10} {'value':>14} {'std':>14} {'std %':>7} {'start':>14}")
-    for n, v, s, s0 in zip(r.names, r.values, r.std, r.start):
-        rel = f"{100 * s / v:7.2f}" if math.isfinite(s) and s < 1e3 * v else "    inf"
-        print(f"{n:<10} {_si(n, v):>14} {_si(n, s) if math.isfinite(s) else 'n/a':>14} {rel} {_si(n, s0):>14}")
+    _print_parameters(r)
     d = np.abs(r.predicted)
     print(f"scan-to-surface distance: RMS {r.rms * 1e3:.4g} mm, median {np.median(d) * 1e3:.4g} mm, "
           f"max {d.max() * 1e3:.4g} mm; chi2/dof {r.s2:.4g}")
