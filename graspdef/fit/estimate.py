@@ -266,6 +266,10 @@ def fit(model: Callable[[dict], np.ndarray], table: MeasuredTable, start: dict, 
         J = jac(z)
     except ForwardFailed as exc:
         z, converged, message, J = best["z"], False, str(exc), None
+        if not cache:       # not even the start ran: say what to change
+            message += ("; the forward model fails at the start values, so there is nothing to fit from: give "
+                        "other start values (--start; a nonlinear load path that stops at the start is usually a "
+                        "shell too soft for the force: a larger E)")
     if failed:
         warnings_failed = [f"{len(failed)} trial step(s) of the optimiser failed in the forward model and were "
                            f"stepped back from (the first: {failed[0]})"]

@@ -83,12 +83,14 @@ def test_an_unconverged_fit_is_not_reported_as_converged():
 
 
 def test_a_failing_forward_model_is_reported():
-    """A forward model that fails at the start: not converged, the reason and theta in the message."""
+    """A forward model that fails at the start: not converged, the reason and theta in the message,
+    and what to change (other start values)."""
     def broken(theta):
         raise SolverError("the load path stopped at load factor 0.3")
 
     r = fit(broken, _table(F), {"E": 1.0})
     assert not r.converged and "load path stopped" in r.message and "E = 1" in r.message
+    assert "give other start values" in r.message
     assert all(math.isnan(s) for s in r.std)
 
 
