@@ -22,9 +22,13 @@ gives 4.29 -> 1.64 -> 1.18 -> 1.51: the last interval re-stiffens.  This script 
    (contact points, friction) are not exactly proportional to the force -- 2 N at 1 MPa and 4 N at
    2 MPa differ by 8e-4 in the indentation (15.865 vs 15.878 mm, 1,280 faces).
 
+4. the wall thickness set free (a felt cover thickens the wall that bends; the scan's 2.5 mm is the
+   rubber's): graspdef.fit on all four rows, (E, t) without air and (E, t, p) with air, from the
+   values above; their residuals and secant stiffnesses (``--thickness-fits``).
+
     PYTHONPATH=. python scripts/ball_softening_study.py [--faces 1280,5120] [--E-MPa 11.12 --p-kPa 7.35]
                                                         [--xval out/gallery/paper_cross_validation/paper_cross_validation.json]
-                                                        [--out out/ball_softening]
+                                                        [--thickness-fits] [--out out/ball_softening]
 
 Writes ball_softening.json (SI units) and prints its tables.
 """
@@ -158,6 +162,42 @@ def fit_scaled(F_sweep, d_sweep, E0, F, d) -> tuple[float, np.ndarray]:
     return E, pred(E)
 
 
+def thickness_fits(F, d) -> dict:
+    """Part 4: all four rows fitted with the thickness free, without air (E, t) and with it (E, t, p)."""
+    from graspdef.errors import GraspdefError
+    from graspdef.fit import ObjectModel, fit, read_table
+
+    table = read_table(TABLE)
+    out = {}
+    for key, gas, start in (("no air: E, t", False, {"E": 14e6, "thickness": 2.5e-3}),
+                            ("air: E, t, p", None, {"E": 11e6, "thickness": 2.5e-3, "pressure": 7.4e3})):
+        print(f"fitting {key} to the four rows", flush=True)
+        try:
+            om = ObjectModel("tennis_ball", table, list(start), "nonlinear", gas=gas)
+            r = fit(om, table, start, max_nfev=40)
+        except GraspdefError as exc:
+            out[key] = {"failure": str(exc)}
+            continue
+        out[key] = {"parameters": dict(zip(r.names, r.values.tolist())), "std": dict(zip(r.names, r.std.tolist())),
+                    "converged": r.converged, "rows_m": r.predicted.tolist(), "rms_m": r.rms,
+                    "secant_N_per_mm": measured_shape(F, r.predicted)["secant_N_per_mm"],
+                    "warnings": list(r.warnings), "solves": om.n_solves, "seconds": r.seconds}
+    return out
+
+
+def show_fit(key: str, v: dict, F) -> None:
+    if "failure" in v:
+        print(f"{key}: failed: {v['failure']}", flush=True)
+        return
+    par = ", ".join(f"{k} = {x / 1e6:.3g} MPa" if k == "E" else f"{k} = {x * 1e3:.3g} mm" if k == "thickness"
+                    else f"{k} = {x / 1e3:.3g} kPa" for k, x in v["parameters"].items())
+    print(f"{key}: {par}{'' if v['converged'] else ' (NOT converged)'}; rows " + " / ".join(
+        f"{y * 1e3:.2f}" for y in v["rows_m"]) + f" mm, RMS {v['rms_m'] * 1e3:.3f} mm; secants "
+        + " / ".join(f"{k:.2f}" for k in v["secant_N_per_mm"]) + " N/mm", flush=True)
+    for w in v["warnings"]:
+        print(f"  warning: {w}", flush=True)
+
+
 def derive_air(ent: dict, F) -> dict:
     """An air sweep's derived figures from its points (see air_share)."""
     ok = [q for q in ent["points"] if "max_m" in q]
@@ -197,6 +237,7 @@ def main() -> int:
     ap.add_argument("--E-MPa", type=float, default=None)
     ap.add_argument("--p-kPa", type=float, default=None)
     ap.add_argument("--skip", default="", help="parts to skip: air, noair")
+    ap.add_argument("--thickness-fits", action="store_true", help="part 4: fits with the wall thickness free")
     ap.add_argument("--from-json", default=None, help="re-derive the figures of a finished run's JSON (no solves)")
     ap.add_argument("--out", default=str(ROOT / "out" / "ball_softening"))
     a = ap.parse_args()
@@ -257,6 +298,12 @@ def main() -> int:
                     "control_vertices": int(om.obj.shell_info.get("control_vertices", 0)),
                     "points": sweep(om, {"E": E0}, NOAIR_FORCES, lambda s: print(s, flush=True))}
             derive_noair(rec["no_air"]["meshes"][str(nf)], E0, F, d)
+
+    if a.thickness_fits:
+        rec["thickness_fits"] = old.get("thickness_fits") if old is not None and "thickness_fits" in old else \
+            thickness_fits(F, d)
+        for k, v in rec["thickness_fits"].items():
+            show_fit(k, v, F)
 
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
