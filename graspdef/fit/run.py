@@ -107,6 +107,9 @@ def fit_object_scan(scene, scan, force: float, params: str, analysis: str = "non
         raise ProblemError(f"analysis must be 'linear' or 'nonlinear', got {analysis!r}")
     if not (isinstance(max_iterations, int) and max_iterations >= 1):
         raise ProblemError(f"--max-iterations must be a positive integer, got {max_iterations!r}")
+    if model != "full":
+        raise ProblemError("--scan fits the full object's surface (--model full): the patch model has no whole "
+                           "surface to register a scan onto")
     if not (isinstance(force, (int, float)) and force > 0):
         raise ProblemError(f"--force must be a positive force (the scan's force per finger), got {force!r}")
     if sigma is not None and not (isinstance(sigma, (int, float)) and math.isfinite(sigma) and sigma > 0):

@@ -63,6 +63,8 @@ CASES = {
                            "states no units"),
     "--near without unit": (lambda t: ["tennis_ball", "--scan", _ply(t), "--scan-units", "m", "--force", "10N",
                                        "--near", "20", "--params", "E"], "needs a unit"),
+    "--scan with the patch model": (lambda t: ["tennis_ball", "--scan", _ply(t), "--scan-units", "m", "--force",
+                                               "10N", "--model", "patch", "--params", "E"], "--model full"),
     "--out holds other files": (lambda t: ["tennis_ball", "--data", _csv(t, GOOD), "--params", "E", "--out",
                                            str(t / "photos")], "not a graspdef run folder"),
 }
