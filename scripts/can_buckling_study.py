@@ -32,6 +32,10 @@ Writes ``can_buckling.json``, ``can_buckling.csv`` (every path point) and ``can_
 ``--out`` (default out/can_buckling) and prints a Markdown table.
 
     PYTHONPATH=. python scripts/can_buckling_study.py [--fast] [--n 96] [--amplitudes 0,0.5,1,3]
+        [--dimple-l-mm 3.68] [--max-force 6] [--max-disp-mm 3] [--steps 24] [--full-check]
+
+Measured 2026-11-26 (two shared cores): default run 18 min (4 cases of 9.8k control vertices,
+3-6 min each), --full-check adds 4 min (8.6k), --fast 80 s.  Results in docs/grasp.md ("Soda can").
 """
 from __future__ import annotations
 
@@ -51,9 +55,9 @@ F_PAPER, D_PAPER = 0.76, 1.42e-3          # Tian & Jia 2010, Table I: N per fing
 DIMPLE_L = 2.0 * math.sqrt(R * T)          # [m] e-folding radius of the imperfection
 
 
-def build(n: int, amplitude: float):
+def build(n: int, amplitude: float, width: float = DIMPLE_L):
     """The 1/8 can on an n x n mesh with an inward dimple of depth ``amplitude`` [m] at the load
-    point; the point load is F/4 = 0.25 N (load factor 1 = 1 N per finger)."""
+    point (e-folding radius ``width`` [m]); the point load is F/4 = 0.25 N (load factor 1 = 1 N per finger)."""
     from graspdef.geometry import primitives as prim
     from graspdef.problem.loads import PointLoad
     from graspdef.problem.problem import Problem, locate
@@ -65,7 +69,7 @@ def build(n: int, amplitude: float):
     v = m.vertices.copy()
     theta = np.arctan2(v[:, 1], v[:, 0])
     s, zeta = R * theta, v[:, 2] - L / 2
-    w0 = -amplitude * np.exp(-(s ** 2 + zeta ** 2) / DIMPLE_L ** 2)       # radial, outward positive
+    w0 = -amplitude * np.exp(-(s ** 2 + zeta ** 2) / width ** 2)       # radial, outward positive
     v[:, 0] += w0 * np.cos(theta)
     v[:, 1] += w0 * np.sin(theta)
     shell = Shell(v, m.faces, make_material("linear_elastic", {"E": E, "nu": NU}), T)
@@ -96,12 +100,13 @@ def _point(pr, name, u):
     return w @ (pr.shell.rest_positions[st] + u[st])
 
 
-def run_case(n: int, amplitude: float, max_force: float, max_disp: float, steps: int = 24, progress=print) -> dict:
+def run_case(n: int, amplitude: float, max_force: float, max_disp: float, steps: int = 24, width: float = DIMPLE_L,
+             progress=print) -> dict:
     from graspdef.solve.linear import solve_linear
     from graspdef.solve.nonlinear import PathOptions, solve_nonlinear
 
     t0 = time.perf_counter()
-    pr, depth = build(n, amplitude)
+    pr, depth = build(n, amplitude, width)
     lin_sol = solve_linear(pr)
     sp = pr.probes["A"]
     st, w = pr.evaluator.values(sp.face, np.asarray(sp.bary))
@@ -123,7 +128,7 @@ def run_case(n: int, amplitude: float, max_force: float, max_disp: float, steps:
                     "negative_eigenvalues": p.instability, "kind": p.kind})
     f = np.array([q["force_N"] for q in pts])
     d = np.array([q["disp_A_m"] for q in pts])
-    out = {"amplitude_m": amplitude, "amplitude_over_t": amplitude / T, "dimple_depth_limit_surface_m": depth,
+    out = {"amplitude_m": amplitude, "amplitude_over_t": amplitude / T, "dimple_width_m": width, "dimple_depth_limit_surface_m": depth,
            "n": n, "n_control": int(pr.shell.n_control), "linear_m_per_N": lin,
            "completed": bool(sol.completed), "stop_reason": sol.stop_reason,
            "seconds": time.perf_counter() - t0, "n_factorisations": int(sol.n_factorisations),
@@ -148,12 +153,13 @@ def _first_crossing(x, y, x0):
 
 
 def table(results) -> str:
-    rows = ["| imperfection A (dimple depth on the surface) | linear at 0.76 N | nonlinear at 0.76 N | first limit point: F, displacement, negative eigenvalues before/after | force at 1.42 mm | followed to | control vertices, time |",
+    rows = ["| imperfection A (dimple depth on the surface) | linear at 0.76 N | nonlinear at 0.76 N | first change of stability: kind, F, displacement, negative eigenvalues before → after | force at 1.42 mm | followed to | control vertices, time |",
             "|---|---|---|---|---|---|---|"]
     for r in results:
-        lp = r["first_limit_point"]
-        lps = (f"{lp['load_factor']:.3f} N, {lp['disp_A_m'] * 1e3:.3f} mm, {lp['instability_before']} → {lp['instability_after']}"
-               if lp else "none")
+        cps = r["critical_points"]
+        lp = cps[0] if cps else None
+        lps = (f"{lp['kind']}, {lp['load_factor']:.3f} N, {lp['disp_A_m'] * 1e3:.3f} mm, "
+               f"{lp['instability_before']} → {lp['instability_after']}" if lp else "none (stable throughout)")
         fd = r["force_at_paper_disp_N"]
         d76 = r["disp_at_paper_force_m"]
         lin = "—" if r["linear_m_per_N"] is None else f"{r['linear_m_per_N'] * F_PAPER * 1e3:.3f} mm"
@@ -234,7 +240,8 @@ def figure(results, path: Path, full=None) -> None:
     ax.axvline(D_PAPER * 1e3, color="0.6", lw=0.8)
     ax.set_xlabel("load-point displacement (inward, per finger) [mm]")
     ax.set_ylabel("force per finger [N]")
-    ax.set_title(f"ideal can, SVK, arc length; x: unstable (1/8 model, {results[0]['n']}² cells)")
+    ax.set_title("ideal can, SVK, arc length; x: unstable"
+                 + (f" (1/8 model, {results[0]['n']}² cells)" if results else ""))
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
@@ -245,8 +252,10 @@ def main() -> int:
     ap.add_argument("--fast", action="store_true", help="32 x 32 cells (too coarse for the dimple)")
     ap.add_argument("--n", type=int, default=None, help="cells per side of the 1/8 model (default 96)")
     ap.add_argument("--amplitudes", default="0,0.5,1,3", help="dimple depths in wall thicknesses")
-    ap.add_argument("--max-force", type=float, default=4.0, help="[N per finger] end of the path")
+    ap.add_argument("--max-force", type=float, default=6.0, help="[N per finger] end of the path")
     ap.add_argument("--max-disp-mm", type=float, default=3.0, help="[mm] the path also ends here")
+    ap.add_argument("--dimple-l-mm", type=float, default=DIMPLE_L * 1e3,
+                    help=f"[mm] e-folding radius of the dimple (default 2 sqrt(R t) = {DIMPLE_L * 1e3:.2f} mm)")
     ap.add_argument("--steps", type=int, default=24,
                     help="initial arc length = the tangent's length over max_force / steps (it adapts, up to 8x)")
     ap.add_argument("--full-check", action="store_true",
@@ -262,13 +271,13 @@ def main() -> int:
     results = []
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    for amp in [float(x) * T for x in a.amplitudes.split(",")]:
-        r = run_case(n, amp, a.max_force, a.max_disp_mm * 1e-3, a.steps)
+    for amp in [float(x) * T for x in a.amplitudes.split(",") if x.strip()]:   # "": the full check only
+        r = run_case(n, amp, a.max_force, a.max_disp_mm * 1e-3, a.steps, a.dimple_l_mm * 1e-3)
         results.append(r)
         print(table([r]).splitlines()[-1], flush=True)
         (out / "can_buckling.json").write_text(json.dumps(
             {"units": {"force": "N per finger", "displacement": "m", "amplitude": "m"},
-             "model": f"1/8 ideal can, {n} x {n} cells, SVK, arc length; dimple l = {DIMPLE_L:.4g} m",
+             "model": f"1/8 ideal can, {n} x {n} cells, SVK, arc length; dimple l = {a.dimple_l_mm * 1e-3:.4g} m",
              "paper": {"force_N": F_PAPER, "max_displacement_m": D_PAPER}, "results": results}, indent=1) + "\n")
     with open(out / "can_buckling.csv", "w", newline="") as fh:
         wr = csv.writer(fh)
