@@ -18,7 +18,8 @@ Model: the 1/8 can (theta in [0, 90 deg], z from the lid to mid-height), symmetr
 x = 0 and z = L/2, the lid a rigid diaphragm (as in the problem file); the point load F/4 at the
 corner (R, 0, L/2) (the load point lies on two symmetry planes); the load factor is the force per
 finger F [N].  A uniform n x n mesh of the 1/8 model (default 96 x 96: 9,409 vertices, 9,799
-control points with the ghost layer, cells 0.55 x 0.53 mm, about 3.3 cells per sqrt(R t) = 1.84 mm, the width of a point load's dimple;
+control points with the ghost layer, cells 0.55 x 0.53 mm, about 3.3 cells per sqrt(R t) = 1.84 mm,
+the width of a point load's dimple;
 ``--fast``: 32 x 32, 1.7 x 1.6 mm cells, the full 8.3k model's resolution, about one cell per
 sqrt(R t): too coarse to resolve the dimple's shape, yet within 3 % of 96 x 96 for the perfect can
 (measured: 0.120 / 0.122 / 0.123 mm at 0.76 N, 1.42 mm at 3.651 / 3.657 / 3.656 N on 32 / 64 / 96)).
