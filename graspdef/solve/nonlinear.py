@@ -64,6 +64,11 @@ class PathOptions:
     reuse_factorisation, reuse_ratio : in load control, reuse a factorised tangent (the previous
         converged point's) while the residual contracts by reuse_ratio per iteration (modified Newton)
     anderson : depth of the Anderson mixing of the modified-Newton corrections (0: plain)
+    krylov, krylov_rtol : where the reused tangent contracts too slowly, first try an inexact Newton
+        step -- the Hessian at the iterate, its Newton system solved by GMRES preconditioned by the
+        reused factorisation to a residual of krylov_rtol times the modified-Newton correction --
+        and factorise only when GMRES needs more than ``krylov`` iterations (0: always factorise,
+        the behaviour before); see :meth:`PathSolver.newton`
     inertia_rtol : the stability of a point is the inertia of a Hessian factorised within this
         relative residual of it (0: at the converged state itself); see :meth:`PathSolver.newton`
     bifurcation : what a load-controlled path does at a change of stability that is not a limit
@@ -94,6 +99,8 @@ class PathOptions:
     reuse_ratio: float = 0.9
     anderson: int = 5
     inertia_rtol: float = 1e-4
+    krylov: int = 20
+    krylov_rtol: float = 1e-2
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -114,6 +121,10 @@ class PathOptions:
             raise ProblemError(f"bifurcation must be one of {', '.join(BIFURCATION)}, got {self.bifurcation!r}")
         if not (0 <= self.inertia_rtol < 1e-2):
             raise ProblemError(f"inertia_rtol must lie in [0, 1e-2), got {self.inertia_rtol!r}")
+        if not isinstance(self.krylov, (int, np.integer)) or self.krylov < 0:
+            raise ProblemError(f"krylov must be a non-negative integer, got {self.krylov!r}")
+        if not (0 < self.krylov_rtol < 1):
+            raise ProblemError(f"krylov_rtol must lie in (0, 1), got {self.krylov_rtol!r}")
         if not (0 < self.reuse_ratio < 1):
             raise ProblemError(f"reuse_ratio must lie in (0, 1), got {self.reuse_ratio!r}")
         if not self.max_growth > 1:
@@ -165,7 +176,9 @@ class NonlinearSolution(DisplacementField):
     critical_points : detected limit and bifurcation points (dicts)
     events : every attempt that failed and was cut (from, to, reason): with each point's
         ``extra["converged_by"]`` the path says why every step stopped where it did
-    timings : seconds;  n_factorisations : tangent factorisations
+    timings : seconds;  n_factorisations : tangent factorisations;  n_hessians : Hessian
+        evaluations;  n_back_substitutions : back-substitutions (each right-hand side);
+        n_krylov : GMRES iterations of inexact Newton steps;  n_inexact : inexact Newton steps
     """
 
     problem: Problem
@@ -177,6 +190,10 @@ class NonlinearSolution(DisplacementField):
     events: list = field(default_factory=list)        # every failed attempt: load factor, step, reason
     timings: dict = field(default_factory=dict)
     n_factorisations: int = 0
+    n_hessians: int = 0
+    n_back_substitutions: int = 0
+    n_krylov: int = 0
+    n_inexact: int = 0
 
     @property
     def u(self) -> np.ndarray:
@@ -227,6 +244,7 @@ class PathSolver:
         self.residual = (0.0, 0.0)        # (relative residual, relative floor) of the last test
         self.last_step = np.inf           # |last correction| / |u| of the current Newton solve
         self.switched = False             # a branch switch has been made (one per path)
+        self.n_inexact = 0                # inexact (GMRES) Newton steps taken
 
     # ---------------------------------------------------------------------------------------
     def _record(self, u, lam, state, its, inst, kind="step") -> PathPoint:
@@ -304,7 +322,17 @@ class PathSolver:
         residual falls below it on a tangent from elsewhere, the tangent is refreshed there, and
         that factorisation finishes the iterations, gives the stability and is the next step's
         predictor and tangent.  With ``inertia_rtol = 0`` the converged state itself is always
-        factorised (one more factorisation per point)."""
+        factorised (one more factorisation per point).
+
+        Inexact Newton (``krylov`` > 0): where the reused tangent contracts poorly (or its step
+        raises the energy) above ``inertia_rtol``, the Hessian at the iterate is evaluated and its
+        Newton system solved by GMRES preconditioned by the reused factorisation
+        (:meth:`Equilibrium.inexact_step`); the following iterations do the same (a Hessian and a
+        few back-substitutions each, no factorisation) until the residual is below
+        ``inertia_rtol`` -- where the tangent is factorised as above, for the stability -- or
+        GMRES needs more than ``krylov`` iterations or the inexact steps stop contracting by
+        ``reuse_ratio``: then the tangent is factorised there, as without them.  An inexact step
+        never gives a stability: that comes only from factorisations, as above."""
         eq, opt = self.eq, self.opt
         u = u0.copy()
         first = prev = None
@@ -312,9 +340,27 @@ class PathSolver:
         hist: list[tuple[np.ndarray, np.ndarray]] = []      # (u_k, du_k) since the factorisation
         back = None                                          # state before an Anderson step
         near = None                 # inertia of a factorisation at an iterate within inertia_rtol
+        inexact = False             # the iterations since the last factorisation are GMRES steps
         self.last_step = np.inf
+
+        def refresh(st, cres):
+            """A step on the tangent of ``st`` (Hessian evaluated): inexact (GMRES) if it converges
+            within ``krylov`` iterations, else on a fresh factorisation; returns (du, exact)."""
+            nonlocal near, hist, inexact
+            du = eq.solve(-st.gradient, cres)
+            if opt.krylov and near is None:
+                di = eq.inexact_step(st, -st.gradient, du, opt.krylov_rtol, opt.krylov)
+                if di is not None:
+                    self.n_inexact += 1
+                    inexact, hist = True, []
+                    return di, False
+            inst = eq.factor(st)
+            near = (inst, rel) if rel <= opt.inertia_rtol else None
+            inexact, hist = False, []
+            return eq.solve(-st.gradient, cres), True
+
         for it in range(opt.max_iterations + 1):
-            st = eq.evaluate(u, lam, 2 if need_h else 1)
+            st = eq.evaluate(u, lam, 2 if need_h or inexact else 1)
             if not np.isfinite(st.energy) or not np.all(np.isfinite(st.gradient)):
                 if back is None:
                     raise _Failed(f"non-finite energy or forces at load factor {lam:.6g}")
@@ -334,18 +380,28 @@ class PathSolver:
             first = rel if first is None else first
             if it >= 8 and rel > 10 * first:
                 raise _Failed(f"Newton diverges at load factor {lam:.6g} (residual {rel:.2e})")
-            if not need_h and (near is None and rel <= opt.inertia_rtol
-                               or prev is not None and rel > opt.reuse_ratio * prev):
+            poor = prev is not None and rel > opt.reuse_ratio * prev
+            fresh = False                 # du is a step on this iterate's tangent (exact or GMRES)
+            cres = eq.constraint_residual(u, lam)
+            if not need_h and (near is None and rel <= opt.inertia_rtol or inexact and poor):
                 # nearly converged on a tangent from elsewhere (its factorisation at this iterate
-                # gives the stability and the final iterations), or poor contraction: fresh tangent
-                st = eq.evaluate(u, lam, 2)
+                # gives the stability and the final iterations), or inexact steps that do not
+                # contract: fresh tangent
+                if st.hessian is None:
+                    st = eq.evaluate(u, lam, 2)
                 need_h = True
-            if need_h:
+            elif not need_h and (inexact or poor):
+                # poor contraction of the reused tangent: this iterate's tangent, by GMRES if it can
+                if st.hessian is None:
+                    st = eq.evaluate(u, lam, 2)
+                du, need_h = refresh(st, cres)
+                fresh = True
+            if need_h and not fresh:
                 inst = eq.factor(st)
                 near = (inst, rel) if rel <= opt.inertia_rtol else None
-                hist = []
-            cres = eq.constraint_residual(u, lam)
-            du = eq.solve(-st.gradient, cres)
+                hist, inexact = [], False
+            if not fresh:
+                du = eq.solve(-st.gradient, cres)
             # the supports hold to solve precision: the step need not restore them, and the energy
             # is a merit function along it
             feasible = float(np.linalg.norm(cres)) <= 1e-8 * max(float(np.linalg.norm(u)), float(np.linalg.norm(du)),
@@ -367,12 +423,11 @@ class PathSolver:
                 # step is accepted as it is
                 if slope < 0 and -slope > 1e-10 * abs(st.energy):
                     e_new = eq.energy(u + du, lam)
-                    if not need_h and not (np.isfinite(e_new) and e_new <= st.energy + 1e-4 * slope):
-                        # a reused tangent whose step does not decrease the energy: refactorise here
+                    if not (need_h or fresh) and not (np.isfinite(e_new) and e_new <= st.energy + 1e-4 * slope):
+                        # a reused tangent whose step does not decrease the energy: this iterate's
+                        # tangent (by GMRES if it can, else factorised here)
                         st = eq.evaluate(u, lam, 2)
-                        eq.factor(st)
-                        need_h, hist = True, []
-                        du = eq.solve(-st.gradient, cres)
+                        du, need_h = refresh(st, cres)
                         slope = float(st.gradient @ du)
                         e_new = eq.energy(u + du, lam)
                     for _ in range(8):
@@ -383,10 +438,10 @@ class PathSolver:
                     else:
                         alpha = 1.0                      # no decrease found: plain Newton step
                 step = alpha * du
-            if feasible and opt.reuse_factorisation:
+            if feasible and opt.reuse_factorisation and not inexact:
                 hist = ([(u, du)] + hist)[: opt.anderson]
             log.debug("  newton it %d lam %.6g rel %.2e (floor %.2e) alpha %.3g |du| %.3e tangent %s%s", it, lam, rel, self.residual[1], alpha,
-                      float(np.linalg.norm(du)), "new" if need_h else "reused",
+                      float(np.linalg.norm(du)), "new" if need_h else "inexact" if inexact else "reused",
                       f" (Anderson {len(hist) - 1})" if len(hist) > 1 else "")
             u = u + step
             prev = rel
@@ -477,6 +532,10 @@ class PathSolver:
         sol.timings["factor"] = self.eq.kkt.seconds_factor
         sol.timings["solve"] = self.eq.kkt.seconds_solve
         sol.n_factorisations = self.eq.n_factorisations
+        sol.n_hessians = self.eq.n_hessians
+        sol.n_back_substitutions = self.eq.kkt.n_back
+        sol.n_krylov = self.eq.n_krylov
+        sol.n_inexact = self.n_inexact
         sol.completed = sol.stop_reason is None
         self._detect(sol)
         self._classify(sol)
