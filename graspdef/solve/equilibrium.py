@@ -206,21 +206,33 @@ class Equilibrium:
         null space of C)."""
         return v - self.C.T @ self._CCt.solve(self.C @ v) if self.m else v
 
-    def inexact_step(self, state: State, rhs: np.ndarray, du0: np.ndarray, rtol: float,
-                     maxiter: int) -> np.ndarray | None:
-        """The Newton step of ``state``'s tangent A = H + sum c v v^T by GMRES preconditioned by the
-        last factorisation (that of an earlier tangent): du with A du + C^T l = rhs, C du = g,
-        where ``du0`` -- the last factorisation's solution of the same system -- already satisfies
+    def inexact_step(self, u: np.ndarray, lam: float, state: State, rhs: np.ndarray, du0: np.ndarray,
+                     rtol: float, maxiter: int) -> np.ndarray | None:
+        """The Newton step at (u, lam) by GMRES preconditioned by the last factorisation (that of an
+        earlier tangent): du with A du + C^T l = rhs, C du = g, where A is the tangent at u and
+        ``du0`` -- the last factorisation's solution of the same system -- already satisfies
         C du0 = g.  The correction d = du - du0 lies in the null space of C: with R the orthogonal
         projection onto it and P = :meth:`precondition` (which maps into it), GMRES on R A P y =
         R (rhs - A du0), d = P y, until the true projected residual |R (rhs - A du)| is at most
         ``rtol`` |R rhs| (the inexact Newton condition |F + J s| <= eta |F|, Eisenstat & Walker
-        1996).  Returns du, or None when GMRES needs more than ``maxiter`` iterations (the tangent
-        is too far from the factorised one: factorise it).  The accuracy of this step only decides
-        how fast Newton converges, never where: the convergence test is on the true residual."""
+        1996).  A v is the state's Hessian (with its rank-one parts) times v if ``state`` has one,
+        else a forward difference of the gradient (``state.gradient`` at u), (grad(u + h v) -
+        grad(u)) / h with h |v| = sqrt(eps) |X + u| (Jacobian-free Newton-Krylov, Knoll & Keyes
+        2004: a gradient costs a fraction of a Hessian; its relative error, ~1e-7 on the ball, is
+        far below any ``rtol`` used).  Returns du, or None when GMRES needs more than ``maxiter``
+        iterations (the tangent is too far from the factorised one: factorise it).  The accuracy
+        of this step only decides how fast Newton converges, never where: the convergence test
+        is on the true residual."""
         H, r1 = state.hessian, state.rank_one
+        size = np.sqrt(np.finfo(float).eps) * float(np.linalg.norm(self.X.ravel() + u))
 
         def tangent(d):
+            if H is None:
+                dn = float(np.linalg.norm(d))
+                if dn == 0:
+                    return np.zeros_like(d)
+                h = size / dn
+                return (self.evaluate(u + h * d, lam, 1).gradient - state.gradient) / h
             y = H @ d
             for c, v in r1:
                 y = y + (c * float(v @ d)) * v

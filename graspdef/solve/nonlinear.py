@@ -65,8 +65,8 @@ class PathOptions:
         converged point's) while the residual contracts by reuse_ratio per iteration (modified Newton)
     anderson : depth of the Anderson mixing of the modified-Newton corrections (0: plain)
     krylov, krylov_rtol : where the reused tangent contracts too slowly, first try an inexact Newton
-        step -- the Hessian at the iterate, its Newton system solved by GMRES preconditioned by the
-        reused factorisation to a residual of krylov_rtol times the modified-Newton correction --
+        step -- the Newton system at the iterate solved by GMRES preconditioned by the reused
+        factorisation (tangent products by gradient differences) to krylov_rtol times its residual --
         and factorise only when GMRES needs more than ``krylov`` iterations (0: always factorise,
         the behaviour before); see :meth:`PathSolver.newton`
     inertia_rtol : the stability of a point is the inertia of a Hessian factorised within this
@@ -325,10 +325,10 @@ class PathSolver:
         factorised (one more factorisation per point).
 
         Inexact Newton (``krylov`` > 0): where the reused tangent contracts poorly (or its step
-        raises the energy) above ``inertia_rtol``, the Hessian at the iterate is evaluated and its
-        Newton system solved by GMRES preconditioned by the reused factorisation
-        (:meth:`Equilibrium.inexact_step`); the following iterations do the same (a Hessian and a
-        few back-substitutions each, no factorisation) until the residual is below
+        raises the energy) above ``inertia_rtol``, the Newton system at the iterate is solved by
+        GMRES preconditioned by the reused factorisation, the tangent's products by differences of
+        gradients (:meth:`Equilibrium.inexact_step`); the following iterations do the same (a
+        gradient and a back-substitution per GMRES iteration; no Hessian, no factorisation) until the residual is below
         ``inertia_rtol`` -- where the tangent is factorised as above, for the stability -- or
         GMRES needs more than ``krylov`` iterations or the inexact steps stop contracting by
         ``reuse_ratio``: then the tangent is factorised there, as without them.  An inexact step
@@ -343,24 +343,26 @@ class PathSolver:
         inexact = False             # the iterations since the last factorisation are GMRES steps
         self.last_step = np.inf
 
-        def refresh(st, cres):
-            """A step on the tangent of ``st`` (Hessian evaluated): inexact (GMRES) if it converges
-            within ``krylov`` iterations, else on a fresh factorisation; returns (du, exact)."""
+        def refresh(u, st, cres):
+            """A step on the tangent at u (``st`` its state): inexact (GMRES) if it converges
+            within ``krylov`` iterations, else on a fresh factorisation; returns (state, du, exact)."""
             nonlocal near, hist, inexact
-            du = eq.solve(-st.gradient, cres)
             if opt.krylov and near is None:
-                di = eq.inexact_step(st, -st.gradient, du, opt.krylov_rtol, opt.krylov)
+                du = eq.solve(-st.gradient, cres)
+                di = eq.inexact_step(u, lam, st, -st.gradient, du, opt.krylov_rtol, opt.krylov)
                 if di is not None:
                     self.n_inexact += 1
                     inexact, hist = True, []
-                    return di, False
+                    return st, di, False
+            if st.hessian is None:
+                st = eq.evaluate(u, lam, 2)
             inst = eq.factor(st)
             near = (inst, rel) if rel <= opt.inertia_rtol else None
             inexact, hist = False, []
-            return eq.solve(-st.gradient, cres), True
+            return st, eq.solve(-st.gradient, cres), True
 
         for it in range(opt.max_iterations + 1):
-            st = eq.evaluate(u, lam, 2 if need_h or inexact else 1)
+            st = eq.evaluate(u, lam, 2 if need_h else 1)
             if not np.isfinite(st.energy) or not np.all(np.isfinite(st.gradient)):
                 if back is None:
                     raise _Failed(f"non-finite energy or forces at load factor {lam:.6g}")
@@ -392,9 +394,7 @@ class PathSolver:
                 need_h = True
             elif not need_h and (inexact or poor):
                 # poor contraction of the reused tangent: this iterate's tangent, by GMRES if it can
-                if st.hessian is None:
-                    st = eq.evaluate(u, lam, 2)
-                du, need_h = refresh(st, cres)
+                st, du, need_h = refresh(u, st, cres)
                 fresh = True
             if need_h and not fresh:
                 inst = eq.factor(st)
@@ -426,8 +426,7 @@ class PathSolver:
                     if not (need_h or fresh) and not (np.isfinite(e_new) and e_new <= st.energy + 1e-4 * slope):
                         # a reused tangent whose step does not decrease the energy: this iterate's
                         # tangent (by GMRES if it can, else factorised here)
-                        st = eq.evaluate(u, lam, 2)
-                        du, need_h = refresh(st, cres)
+                        st, du, need_h = refresh(u, st, cres)
                         slope = float(st.gradient @ du)
                         e_new = eq.energy(u + du, lam)
                     for _ in range(8):

@@ -58,17 +58,24 @@ def test_inexact_step_is_the_newton_step_of_the_current_tangent():
         st = eq.evaluate(u_b, lam, 2)
         cres = eq.constraint_residual(u_b, lam)
         du0 = eq.solve(-st.gradient, cres)                          # modified-Newton step
-        du = eq.inexact_step(st, -st.gradient, du0, 1e-10, 200)
+        du = eq.inexact_step(u_b, lam, st, -st.gradient, du0, 1e-10, 200)      # products with H
         assert du is not None and eq.n_krylov > 1
-        assert eq.inexact_step(st, -st.gradient, du0, 1e-10, 1) is None   # not in one iteration
+        st1 = eq.evaluate(u_b, lam, 1)                              # no Hessian: gradient differences
+        assert st1.hessian is None
+        du_fd = eq.inexact_step(u_b, lam, st1, -st1.gradient, du0, 1e-6, 200)
+        assert du_fd is not None
+        assert eq.inexact_step(u_b, lam, st, -st.gradient, du0, 1e-10, 1) is None   # not in one iteration
         eq.factor(st)                                               # the current tangent, exactly
         exact = eq.solve(-st.gradient, cres)
     finally:
         eq.close()
     scale = np.abs(exact).max()
+    print(np.abs(du - exact).max() / scale, np.abs(du_fd - exact).max() / scale, np.abs(du0 - exact).max() / scale)
     assert np.abs(du - exact).max() <= 1e-7 * scale
+    assert np.abs(du_fd - exact).max() <= 1e-5 * scale
     assert np.abs(du0 - exact).max() > 1e-2 * scale                  # the stale step is far from it
-    assert np.abs(eq.C @ du - cres).max() <= 1e-12 * scale
+    for d in (du, du_fd):
+        assert np.abs(eq.C @ d - cres).max() <= 1e-12 * scale
 
 
 def test_path_with_inexact_steps_reaches_the_same_points_with_fewer_factorisations():
