@@ -99,6 +99,7 @@ class Equilibrium:
         self.n_factorisations = 0
         self.n_hessians = 0           # order-2 evaluations
         self.n_krylov = 0             # GMRES iterations of inexact Newton steps (one back-substitution each)
+        self.last_krylov = 0          # GMRES iterations of the last inexact step
         self.floor = 0.0              # round-off level of |grad Pi| at the latest Hessian [N]
 
     def close(self) -> None:
@@ -242,6 +243,7 @@ class Equilibrium:
         d, k, _, ok = gmres(lambda v: self.project(tangent(v)), b,
                             rtol * float(np.linalg.norm(self.project(rhs))), maxiter, self.precondition)
         self.n_krylov += k
+        self.last_krylov = k
         if not ok:
             return None
         du = du0 + self.project(d)                       # back onto C d = 0 exactly

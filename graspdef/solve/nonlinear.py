@@ -34,6 +34,8 @@ log = logging.getLogger(__name__)
 
 METHODS = ("load", "arc_length")
 BIFURCATION = ("report", "locate", "switch")
+#: Loosest forcing term of an inexact Newton step (|F + J s| <= eta |F|; Eisenstat & Walker 1996)
+KRYLOV_ETA_MAX = 0.1
 
 
 class PathStopped(SolverError):
@@ -99,7 +101,7 @@ class PathOptions:
     reuse_ratio: float = 0.9
     anderson: int = 5
     inertia_rtol: float = 1e-4
-    krylov: int = 20
+    krylov: int = 10
     krylov_rtol: float = 1e-2
 
     def __post_init__(self) -> None:
@@ -341,15 +343,23 @@ class PathSolver:
         back = None                                          # state before an Anderson step
         near = None                 # inertia of a factorisation at an iterate within inertia_rtol
         inexact = False             # the iterations since the last factorisation are GMRES steps
+        eta = None                  # forcing term of the last inexact step
         self.last_step = np.inf
 
-        def refresh(u, st, cres):
+        def refresh(u, st, cres, tight=False):
             """A step on the tangent at u (``st`` its state): inexact (GMRES) if it converges
-            within ``krylov`` iterations, else on a fresh factorisation; returns (state, du, exact)."""
-            nonlocal near, hist, inexact
+            within ``krylov`` iterations (to krylov_rtol if ``tight``), else on a fresh
+            factorisation; returns (state, du, exact)."""
+            nonlocal near, hist, inexact, eta
             if opt.krylov and near is None:
+                # forcing term (Eisenstat & Walker 1996, choice 2): loose while Newton itself
+                # contracts slowly, down to krylov_rtol as it reaches its quadratic rate
+                e = KRYLOV_ETA_MAX if prev is None else 0.9 * (rel / prev) ** 2
+                if eta is not None and 0.9 * eta ** 2 > 0.1:
+                    e = max(e, 0.9 * eta ** 2)
+                eta = opt.krylov_rtol if tight else float(np.clip(e, opt.krylov_rtol, max(KRYLOV_ETA_MAX, opt.krylov_rtol)))
                 du = eq.solve(-st.gradient, cres)
-                di = eq.inexact_step(u, lam, st, -st.gradient, du, opt.krylov_rtol, opt.krylov)
+                di = eq.inexact_step(u, lam, st, -st.gradient, du, eta, opt.krylov)
                 if di is not None:
                     self.n_inexact += 1
                     inexact, hist = True, []
@@ -385,16 +395,17 @@ class PathSolver:
             poor = prev is not None and rel > opt.reuse_ratio * prev
             fresh = False                 # du is a step on this iterate's tangent (exact or GMRES)
             cres = eq.constraint_residual(u, lam)
-            if not need_h and (near is None and rel <= opt.inertia_rtol or inexact and poor):
+            if not need_h and (near is None and rel <= opt.inertia_rtol
+                               or inexact and poor and eta <= opt.krylov_rtol):
                 # nearly converged on a tangent from elsewhere (its factorisation at this iterate
-                # gives the stability and the final iterations), or inexact steps that do not
-                # contract: fresh tangent
+                # gives the stability and the final iterations), or an inexact step to the tightest
+                # tolerance that did not contract: fresh tangent
                 if st.hessian is None:
                     st = eq.evaluate(u, lam, 2)
                 need_h = True
             elif not need_h and (inexact or poor):
                 # poor contraction of the reused tangent: this iterate's tangent, by GMRES if it can
-                st, du, need_h = refresh(u, st, cres)
+                st, du, need_h = refresh(u, st, cres, tight=inexact and poor)   # a loose step did not contract
                 fresh = True
             if need_h and not fresh:
                 inst = eq.factor(st)
@@ -440,7 +451,7 @@ class PathSolver:
             if feasible and opt.reuse_factorisation and not inexact:
                 hist = ([(u, du)] + hist)[: opt.anderson]
             log.debug("  newton it %d lam %.6g rel %.2e (floor %.2e) alpha %.3g |du| %.3e tangent %s%s", it, lam, rel, self.residual[1], alpha,
-                      float(np.linalg.norm(du)), "new" if need_h else "inexact" if inexact else "reused",
+                      float(np.linalg.norm(du)), "new" if need_h else f"inexact ({eq.last_krylov} GMRES, eta {eta:.1e})" if inexact else "reused",
                       f" (Anderson {len(hist) - 1})" if len(hist) > 1 else "")
             u = u + step
             prev = rel
