@@ -233,15 +233,21 @@ class Equilibrium:
                 if dn == 0:
                     return np.zeros_like(d)
                 h = size / dn
-                return (self.evaluate(u + h * d, lam, 1).gradient - state.gradient) / h
+                y = (self.evaluate(u + h * d, lam, 1).gradient - state.gradient) / h
+                if not np.all(np.isfinite(y)):             # e.g. across a barrier: no inexact step
+                    raise FloatingPointError("non-finite tangent product")
+                return y
             y = H @ d
             for c, v in r1:
                 y = y + (c * float(v @ d)) * v
             return y
 
-        b = self.project(rhs - tangent(du0))
-        d, k, _, ok = gmres(lambda v: self.project(tangent(v)), b,
-                            rtol * float(np.linalg.norm(self.project(rhs))), maxiter, self.precondition)
+        try:
+            b = self.project(rhs - tangent(du0))
+            d, k, _, ok = gmres(lambda v: self.project(tangent(v)), b,
+                                rtol * float(np.linalg.norm(self.project(rhs))), maxiter, self.precondition)
+        except (FloatingPointError, np.linalg.LinAlgError):
+            return None
         self.n_krylov += k
         self.last_krylov = k
         if not ok:

@@ -329,12 +329,15 @@ class PathSolver:
         Inexact Newton (``krylov`` > 0): where the reused tangent contracts poorly (or its step
         raises the energy) above ``inertia_rtol``, the Newton system at the iterate is solved by
         GMRES preconditioned by the reused factorisation, the tangent's products by differences of
-        gradients (:meth:`Equilibrium.inexact_step`); the following iterations do the same (a
-        gradient and a back-substitution per GMRES iteration; no Hessian, no factorisation) until the residual is below
+        gradients (:meth:`Equilibrium.inexact_step`), to a forcing term between 0.1 and
+        ``krylov_rtol`` (Eisenstat & Walker's choice 2: loose while Newton itself contracts
+        slowly); the following iterations do the same (a gradient and a back-substitution per
+        GMRES iteration; no Hessian, no factorisation) until the residual is below
         ``inertia_rtol`` -- where the tangent is factorised as above, for the stability -- or
-        GMRES needs more than ``krylov`` iterations or the inexact steps stop contracting by
-        ``reuse_ratio``: then the tangent is factorised there, as without them.  An inexact step
-        never gives a stability: that comes only from factorisations, as above."""
+        GMRES needs more than ``krylov`` iterations or a step to ``krylov_rtol`` does not contract
+        by ``reuse_ratio`` (a looser one that does not is first retried to ``krylov_rtol``): then
+        the tangent is factorised there, as without them.  An inexact step never gives a
+        stability: that comes only from factorisations, as above."""
         eq, opt = self.eq, self.opt
         u = u0.copy()
         first = prev = None
@@ -357,7 +360,8 @@ class PathSolver:
                 e = KRYLOV_ETA_MAX if prev is None else 0.9 * (rel / prev) ** 2
                 if eta is not None and 0.9 * eta ** 2 > 0.1:
                     e = max(e, 0.9 * eta ** 2)
-                eta = opt.krylov_rtol if tight else float(np.clip(e, opt.krylov_rtol, max(KRYLOV_ETA_MAX, opt.krylov_rtol)))
+                eta = opt.krylov_rtol if tight else float(np.clip(e, opt.krylov_rtol,
+                                                                  max(KRYLOV_ETA_MAX, opt.krylov_rtol)))
                 du = eq.solve(-st.gradient, cres)
                 di = eq.inexact_step(u, lam, st, -st.gradient, du, eta, opt.krylov)
                 if di is not None:
@@ -405,7 +409,8 @@ class PathSolver:
                 need_h = True
             elif not need_h and (inexact or poor):
                 # poor contraction of the reused tangent: this iterate's tangent, by GMRES if it can
-                st, du, need_h = refresh(u, st, cres, tight=inexact and poor)   # a loose step did not contract
+                # (to krylov_rtol if a looser inexact step did not contract)
+                st, du, need_h = refresh(u, st, cres, tight=inexact and poor)
                 fresh = True
             if need_h and not fresh:
                 inst = eq.factor(st)
@@ -451,7 +456,8 @@ class PathSolver:
             if feasible and opt.reuse_factorisation and not inexact:
                 hist = ([(u, du)] + hist)[: opt.anderson]
             log.debug("  newton it %d lam %.6g rel %.2e (floor %.2e) alpha %.3g |du| %.3e tangent %s%s", it, lam, rel, self.residual[1], alpha,
-                      float(np.linalg.norm(du)), "new" if need_h else f"inexact ({eq.last_krylov} GMRES, eta {eta:.1e})" if inexact else "reused",
+                      float(np.linalg.norm(du)),
+                      "new" if need_h else f"inexact ({eq.last_krylov} GMRES, eta {eta:.1e})" if inexact else "reused",
                       f" (Anderson {len(hist) - 1})" if len(hist) > 1 else "")
             u = u + step
             prev = rel
