@@ -1,5 +1,6 @@
 """Inexact Newton steps of the path solver: GMRES on the current tangent, preconditioned by the
-factorisation of an earlier one (graspdef.solve.krylov, Equilibrium.inexact_step, PathOptions.krylov)."""
+factorisation of an earlier one (graspdef.solve.krylov, Equilibrium.inexact_step, PathOptions.krylov;
+off by default)."""
 import numpy as np
 
 from graspdef.geometry import rectangle, sphere
@@ -87,7 +88,7 @@ def test_path_with_inexact_steps_reaches_the_same_points_with_fewer_factorisatio
     Hessian factorised at the converged point itself."""
     pr = _ball(2, 20.0)
     opts = dict(steps=3, desired_iterations=1, reuse_ratio=0.5)     # three equal steps
-    new = solve_nonlinear(pr, PathOptions(**opts))
+    new = solve_nonlinear(pr, PathOptions(krylov=10, **opts))
     old = solve_nonlinear(pr, PathOptions(krylov=0, **opts))
     assert new.n_inexact > 0 and old.n_inexact == 0
     assert new.n_factorisations < old.n_factorisations, (new.n_factorisations, old.n_factorisations)
@@ -119,7 +120,7 @@ def test_stability_across_the_euler_load_with_inexact_steps():
     pr.supports.append(PointSupport(a.face, a.bary, ((1, 0, 0),)))
     P_e = np.pi ** 2 * E * b * t ** 3 / 12 / L ** 2
     pr.loads.append(EdgeLoad(lambda x: np.abs(x[:, 0] - L) < 1e-9, (-1.5 * P_e / b, 0, 0)))
-    new = solve_nonlinear(pr, PathOptions(steps=6, reuse_ratio=0.5))
+    new = solve_nonlinear(pr, PathOptions(steps=6, reuse_ratio=0.5, krylov=10))
     old = solve_nonlinear(pr, PathOptions(steps=6, reuse_ratio=0.5, krylov=0))
     assert new.n_inexact > 0
     eq = Equilibrium(pr)
@@ -131,3 +132,10 @@ def test_stability_across_the_euler_load_with_inexact_steps():
     assert reported == at_point == [p.instability for p in old.path]
     assert reported[0] == 0 and reported[-1] == 1
     assert np.allclose(new.u, old.u, rtol=0, atol=1e-7 * np.abs(old.u).max())
+
+
+def test_inexact_steps_are_off_by_default():
+    """PathOptions.krylov is 0 unless asked for: the default path takes no inexact step."""
+    assert PathOptions().krylov == 0
+    sol = solve_nonlinear(_ball(2, 20.0), PathOptions(steps=3, desired_iterations=1, reuse_ratio=0.5))
+    assert sol.n_inexact == 0 and sol.n_krylov == 0
