@@ -3,12 +3,15 @@ the paper's tennis-ball dimensions) squeezed by two opposite point forces up to 
 steps (issue 3's speed case).  Prints and saves (JSON) the wall time of each run -- set-up,
 path, per-step Newton iterations -- and their median.
 
-    python scripts/bench_nonlinear_speed.py [--subdivisions 5] [--runs 3] [--gas-kpa 80] [--fixed-steps]
+    python scripts/bench_nonlinear_speed.py [--subdivisions 5] [--runs 3] [--gas-kpa 80] [--fixed-steps] [--krylov 10]
                                             [--ref GIT_REF] [--out out/bench_nonlinear_speed.json]
 
 ``--ref``: also run the OLD code of that git ref (checked out into a temporary worktree), its runs
 interleaved with the NEW code's (the working tree), and print both side by side (one untimed small run
 of each tree first warms its numba cache).
+
+``--krylov N`` (10 unless given): the path takes inexact Newton steps (PathOptions.krylov = N, off in
+the solver's default; code before them ignores it).  ``--krylov 0``: the solver's default path.
 
 subdivisions 5 gives 10,242 control vertices.  The ball holds air (80 kPa gauge by default, a
 tennis ball's): without it the path turns at a limit point near 3 N (the pole inverts) and never
@@ -41,6 +44,7 @@ from graspdef.shell.hyperelastic import NeoHookean
 from graspdef.shell.model import Shell
 from graspdef.solve.nonlinear import PathOptions, solve_nonlinear
 sub, steps, force, gas, fixed = int(sys.argv[1]), int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4]), sys.argv[5] == "1"
+krylov = int(sys.argv[6]) if len(sys.argv) > 6 else 0
 t_imp = time.perf_counter()
 R, t = 0.0325, 0.0025
 m = sphere(R, sub)
@@ -55,12 +59,18 @@ def show(i):
     print(f"  point {i['step']}: load factor {i['load_factor']:.4f}, {i['iterations']} Newton iterations, "
           f"{i['seconds']:.1f} s", file=sys.stderr, flush=True)
 # fixed: the steps never grow (desired_iterations = 1), so the path takes exactly `steps` steps
-opts = PathOptions(steps=steps, max_steps=10 * steps, **({"desired_iterations": 1} if fixed else {}))
+opts = PathOptions(steps=steps, max_steps=10 * steps, **({"desired_iterations": 1} if fixed else {}),
+                   # inexact Newton steps where the code has them (older code: ignored)
+                   **({"krylov": krylov} if "krylov" in PathOptions.__dataclass_fields__ else {}))
 sol = solve_nonlinear(pr, opts, progress=show)
 t_end = time.perf_counter()
 print(json.dumps({"n_control": int(shell.mesh.n_real), "import_s": t_imp - t0, "setup_s": t_setup - t_imp,
                   "path_s": t_end - t_setup, "total_s": t_end - t0, "steps": len(sol.path) - 1,
                   "newton_iterations": sol.iterations(), "factorisations": sol.n_factorisations,
+                  # counters the code before inexact Newton steps did not keep: None there
+                  "hessians": getattr(sol, "n_hessians", None),
+                  "back_substitutions": getattr(sol, "n_back_substitutions", None),
+                  "inexact_steps": getattr(sol, "n_inexact", None), "gmres_iterations": getattr(sol, "n_krylov", None),
                   "factor_s": sol.timings["factor"], "solve_s": sol.timings["solve"],
                   "top_displacement_mm": float(-sol.probe("top")[2] * 1e3),
                   "stable": [p.stable for p in sol.path]}))
@@ -71,7 +81,7 @@ def _run(a, tree: Path) -> dict:
     t0 = time.perf_counter()
     env = {**os.environ, "PYTHONPATH": str(tree)}
     res = subprocess.run([sys.executable, "-c", CHILD, str(a.subdivisions), str(a.steps), str(a.force), str(a.gas_kpa),
-                          "1" if a.fixed_steps else "0"], cwd=tree, env=env,
+                          "1" if a.fixed_steps else "0", str(a.krylov)], cwd=tree, env=env,
                          stdout=subprocess.PIPE, stderr=None if a.verbose else subprocess.DEVNULL, text=True)
     if res.returncode:
         raise SystemExit(f"a run in {tree} failed")
@@ -84,7 +94,9 @@ def _show(label: str, k: int, r: dict) -> None:
     print(f"{label} run {k + 1}: {r['n_control']} control vertices, path {r['path_s']:.1f} s (set-up {r['setup_s']:.1f} s, "
           f"factor {r['factor_s']:.1f} s, {r['factorisations']} factorisations), {r['steps']} steps, "
           f"Newton iterations {r['newton_iterations']}, "
-          f"pole displacement {r['top_displacement_mm']:.2f} mm", flush=True)
+          + (f"{r['hessians']} Hessians, {r['back_substitutions']} back-substitutions, {r['inexact_steps']} inexact "
+             f"Newton steps ({r['gmres_iterations']} GMRES iterations), " if r.get("hessians") is not None else "")
+          + f"pole displacement {r['top_displacement_mm']:.2f} mm", flush=True)
 
 
 def main() -> None:
@@ -99,6 +111,9 @@ def main() -> None:
     ap.add_argument("--fixed-steps", action="store_true",
                     help="exactly --steps equal load steps (by default the step grows after easy steps)")
     ap.add_argument("--verbose", action="store_true", help="show each run's progress")
+    ap.add_argument("--krylov", type=int, default=10,
+                    help="PathOptions.krylov: GMRES iterations of an inexact Newton step before a fresh factorisation "
+                         "(0: none, the solver's default; code without the option ignores it)")
     a = ap.parse_args()
     trees = {"NEW": ROOT}
     tmp = None

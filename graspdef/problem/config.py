@@ -54,7 +54,8 @@ _SOLVER = {"backend": "str", "collocation": "int", "type": "str", "method": "str
            "max_load": "float", "targets": "list", "max_steps": "int", "max_iterations": "int", "tol": "float",
            "min_step": "float", "desired_iterations": "int", "max_growth": "float", "line_search": "bool",
            "max_probe_displacement": "length", "refine_critical": "int",
-           "reuse_factorisation": "bool", "reuse_ratio": "float", "anderson": "int", "inertia_rtol": "float"}
+           "reuse_factorisation": "bool", "reuse_ratio": "float", "anderson": "int", "inertia_rtol": "float",
+           "krylov": "int", "krylov_rtol": "float"}
 _LENGTH_KEYS = {"lx", "ly", "center", "a", "b", "c", "radius", "length", "half_width", "scale", "r_inner", "r_outer",
                 "edge_length"}
 _REFERENCE = {"value", "quantity", "tolerance", "source", "formula", "load_factors", "values", "curve",

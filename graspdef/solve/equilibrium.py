@@ -30,6 +30,7 @@ import scipy.sparse.linalg as spla
 from ..errors import SolverError
 from ..problem.problem import Problem
 from ..problem.terms import EnergyTerm
+from .krylov import gmres
 from .sparse import KKTSystem, same_array
 
 
@@ -96,6 +97,9 @@ class Equilibrium:
         self.kkt = KKTSystem(self.C, backend)
         self._CCt = spla.splu((self.C @ self.C.T).tocsc()) if self.m else None
         self.n_factorisations = 0
+        self.n_hessians = 0           # order-2 evaluations
+        self.n_krylov = 0             # GMRES iterations of inexact Newton steps (one back-substitution each)
+        self.last_krylov = 0          # GMRES iterations of the last inexact step
         self.floor = 0.0              # round-off level of |grad Pi| at the latest Hessian [N]
 
     def close(self) -> None:
@@ -125,6 +129,7 @@ class Equilibrium:
                     H = v.hessian if H is None else _add(H, v.hessian)
                 rank_one += v.rank_one
         floor = roundoff_floor(H, x) if order == 2 else None
+        self.n_hessians += order == 2
         if floor is not None:
             self.floor = floor
         return State(float(E), grad, H if order == 2 else None, rank_one, q, internal, floor)
@@ -185,4 +190,69 @@ class Equilibrium:
             du = du - W @ np.linalg.solve(S, V.T @ du)
         if not np.all(np.isfinite(du)):
             raise SolverError("the tangent solve produced non-finite values")
+        return du
+
+    def precondition(self, r: np.ndarray) -> np.ndarray:
+        """The displacement part of the last factorisation's inverse applied to [r; 0] (one raw
+        back-substitution, the rank-one parts by Woodbury): it maps into the null space of C and
+        ignores the range of C^T."""
+        du = self.kkt.back(r)
+        if self._lowrank is not None:
+            V, W, S = self._lowrank
+            du = du - W @ np.linalg.solve(S, V.T @ du)
+        return du
+
+    def project(self, v: np.ndarray) -> np.ndarray:
+        """v less its least-squares part in the range of C^T (the orthogonal projection onto the
+        null space of C)."""
+        return v - self.C.T @ self._CCt.solve(self.C @ v) if self.m else v
+
+    def inexact_step(self, u: np.ndarray, lam: float, state: State, rhs: np.ndarray, du0: np.ndarray,
+                     rtol: float, maxiter: int) -> np.ndarray | None:
+        """The Newton step at (u, lam) by GMRES preconditioned by the last factorisation (that of an
+        earlier tangent): du with A du + C^T l = rhs, C du = g, where A is the tangent at u and
+        ``du0`` -- the last factorisation's solution of the same system -- already satisfies
+        C du0 = g.  The correction d = du - du0 lies in the null space of C: with R the orthogonal
+        projection onto it and P = :meth:`precondition` (which maps into it), GMRES on R A P y =
+        R (rhs - A du0), d = P y, until the true projected residual |R (rhs - A du)| is at most
+        ``rtol`` |R rhs| (the inexact Newton condition |F + J s| <= eta |F|, Eisenstat & Walker
+        1996).  A v is the state's Hessian (with its rank-one parts) times v if ``state`` has one,
+        else a forward difference of the gradient (``state.gradient`` at u), (grad(u + h v) -
+        grad(u)) / h with h |v| = sqrt(eps) |X + u| (Jacobian-free Newton-Krylov, Knoll & Keyes
+        2004: a gradient costs a fraction of a Hessian; its relative error, ~1e-7 on the ball, is
+        far below any ``rtol`` used).  Returns du, or None when GMRES needs more than ``maxiter``
+        iterations (the tangent is too far from the factorised one: factorise it).  The accuracy
+        of this step only decides how fast Newton converges, never where: the convergence test
+        is on the true residual."""
+        H, r1 = state.hessian, state.rank_one
+        size = np.sqrt(np.finfo(float).eps) * float(np.linalg.norm(self.X.ravel() + u))
+
+        def tangent(d):
+            if H is None:
+                dn = float(np.linalg.norm(d))
+                if dn == 0:
+                    return np.zeros_like(d)
+                h = size / dn
+                y = (self.evaluate(u + h * d, lam, 1).gradient - state.gradient) / h
+                if not np.all(np.isfinite(y)):             # e.g. across a barrier: no inexact step
+                    raise FloatingPointError("non-finite tangent product")
+                return y
+            y = H @ d
+            for c, v in r1:
+                y = y + (c * float(v @ d)) * v
+            return y
+
+        try:
+            b = self.project(rhs - tangent(du0))
+            d, k, _, ok = gmres(lambda v: self.project(tangent(v)), b,
+                                rtol * float(np.linalg.norm(self.project(rhs))), maxiter, self.precondition)
+        except (FloatingPointError, np.linalg.LinAlgError):
+            return None
+        self.n_krylov += k
+        self.last_krylov = k
+        if not ok:
+            return None
+        du = du0 + self.project(d)                       # back onto C d = 0 exactly
+        if not np.all(np.isfinite(du)):
+            return None
         return du

@@ -169,6 +169,7 @@ class KKTSystem:
         self.seconds_factor = 0.0
         self.seconds_solve = 0.0
         self.norm = 0.0                   # infinity norm of the last factorised KKT matrix
+        self.n_back = 0                   # back-substitutions (each right-hand side counted)
 
     def __enter__(self):
         return self
@@ -223,7 +224,17 @@ class KKTSystem:
             self.n_negative = None
         self.seconds_factor += time.perf_counter() - t0
 
+    def back(self, f: np.ndarray) -> np.ndarray:
+        """The displacement part of one raw back-substitution of [f; 0] with the last factorisation
+        (no refinement, no residual check): a preconditioner, not a solve."""
+        t0 = time.perf_counter()
+        f = np.asarray(f, float)
+        x = self._back(np.concatenate([f, np.zeros((self.m,) + f.shape[1:])]))[:self.n]
+        self.seconds_solve += time.perf_counter() - t0
+        return x
+
     def _back(self, b: np.ndarray) -> np.ndarray:
+        self.n_back += 1 if b.ndim == 1 else b.shape[1]
         if self.backend == "pardiso":
             self._solver.set_phase(33)
             return self._solver._call_pardiso(self._U, np.asfortranarray(b)).reshape(b.shape)
