@@ -72,21 +72,16 @@ def _model(faces: int, forces, gas: bool, names):
 
 def solve_point(om, theta: dict, force: float) -> dict:
     """One force: max displacement [m], indentation per finger [m] and, with air, its gauge pressure
-    [Pa] and volume [m^3] at the end of the load path (the grasp chain of ObjectModel.record)."""
-    from graspdef.errors import SolverError
+    [Pa] and volume [m^3] at the end of the load path (the last row of the run's path.csv)."""
     from graspdef.fit.models import object_point
-    from graspdef.pipeline.grasp import grasp_record, shell_problem, solve_shell
 
-    obj = om._object(theta)
-    st = om.settled[force]
-    setup = shell_problem(obj, st, "point")
-    solved = solve_shell(setup, "nonlinear", om.steps)
-    if not solved.completed:
-        raise SolverError(f"at {force:g} N the load path stopped: {solved.stop_reason}")
-    rec = grasp_record(obj, st, setup, solved, force, "point", "nonlinear", {}).record.to_json()
-    ex = solved.sol.path[-1].extra
-    return {"force_N": force, "max_m": object_point(rec, "max"), "finger_m": object_point(rec, "finger"),
-            "gauge_pressure_Pa": ex.get("gas0_gauge_pressure_Pa"), "volume_m3": ex.get("gas0_volume_m3")}
+    o = om.outcome(theta, force)
+    rec = o.record.to_json()
+    header, rows = o.path
+    last = dict(zip(header, rows[-1]))
+    gas = {k: (float(last[c]) if c in last else None) for k, c in (("gauge_pressure_Pa", "gas0_gauge_pressure_Pa"),
+                                                                    ("volume_m3", "gas0_volume_m3"))}
+    return {"force_N": force, "max_m": object_point(rec, "max"), "finger_m": object_point(rec, "finger"), **gas}
 
 
 def sweep(om, theta, forces, say) -> list[dict]:

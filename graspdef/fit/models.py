@@ -137,15 +137,16 @@ class ObjectModel:
         that stops raises SolverError."""
         return self.outcome(theta, force).record.to_json()
 
-    def surface(self, theta: dict, force: float, side: str = "mid"):
+    def surface(self, theta: dict, force: float, side: str = "mid", outcome=None):
         """The deformed limit surface at ``theta`` and ``force`` [N] (the object's frame, rigid motion
         of a free body removed; a TriMesh [m]): ``side`` "mid" (deformed.ply of the run) or "outer"
-        (moved by half of theta's thickness along its outward normals: what a scanner sees)."""
+        (moved by half of theta's thickness along its outward normals: what a scanner sees).
+        ``outcome``: that solve's GraspOutcome when the caller has it (no second solve)."""
         from ..geometry import TriMesh
 
         if side not in ("mid", "outer"):
             raise ProblemError(f"side must be 'mid' or 'outer', got {side!r}")
-        o = self.outcome(theta, force)
+        o = outcome if outcome is not None else self.outcome(theta, force)
         mesh = TriMesh(o.deformed, o.faces)
         if side == "outer":
             from .scan import outer

@@ -138,11 +138,7 @@ def fit_object_scan(scene, scan, force: float, params: str, analysis: str = "non
         return memo[key]
 
     def surface(theta):
-        from ..geometry import TriMesh
-        from .scan import outer
-
-        o = outcome(theta)
-        return outer(TriMesh(o.deformed, o.faces), 0.5 * float(theta.get("thickness", om.obj.spec.thickness)))
+        return om.surface(theta, float(force), "outer", outcome=outcome(theta))
 
     say(f"solving at the start values for the load points ({len(points)} scan points)")
     rec = outcome(theta0).record.to_json()
