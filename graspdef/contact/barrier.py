@@ -50,7 +50,7 @@ from ..errors import ProblemError
 from ..problem.terms import TermBase
 from .obstacles import Capsule, RoundedBox  # noqa: F401  (the fingertip shapes, used with FingerContact)
 from .condensation import ForceControlledAdvance, NoPosition, condensed_load, condensed_rank_one
-from .sampling import sample_faces, select_faces
+from .sampling import SampleOperator, sample_faces, select_faces
 from ..problem.terms import TermValue as PotentialTerms
 
 
@@ -144,6 +144,8 @@ class FingerContact(TermBase):
         faces, L = select_faces(shell, self._obs, self._e, self.reach, self.depth, self.spacing, self.name)
         self._st, self._N, self._w = sample_faces(shell, ev, faces, L)
         self._faces, self._L, self._n = faces, L, shell.n_control
+        self._ops = SampleOperator(self._st, self._N, shell.n_control)
+        self._kw = self._kappa * self._w.ravel()                 # barrier weight per sample
         self._shell, self._ev = shell, ev
         x_s = self._points(X)
         phi = self._phi(x_s, 0.0, False)[0]
@@ -160,7 +162,7 @@ class FingerContact(TermBase):
     # ---- kinematics --------------------------------------------------------------------------
     def _points(self, x: np.ndarray) -> np.ndarray:
         """Sample points (F, q, 3) of control points x (n, 3)."""
-        return np.einsum("fqs,fsd->fqd", self._N, x[self._st])
+        return self._ops.points(x).reshape(self._N.shape[:2] + (3,))
 
     def _phi(self, pts: np.ndarray, s: float, hessian: bool = True):
         shp = pts.shape[:-1]
@@ -170,7 +172,7 @@ class FingerContact(TermBase):
     def advance(self, x: np.ndarray, F: float) -> float:
         """The finger's advance s* [m] where the barrier force along e equals F [N] (F > 0):
         graspdef.contact.condensation.ForceControlledAdvance over this term's samples."""
-        return self._cond.solve(self._points(x).reshape(-1, 3), (self._kappa * self._w).ravel(), F)
+        return self._cond.solve(self._ops.points(x), self._kw, F)
 
     # ---- potential interface ---------------------------------------------------------------------
     def scaled(self) -> bool:
@@ -178,44 +180,36 @@ class FingerContact(TermBase):
 
     def _terms(self, x, F, order):
         """(s*, value, gradient (3n,), Hessian B_xx or None, B_ss, B_xs (3n,)) at force F > 0;
-        order 1: gradient only, order 2: + B_ss and B_xs, order 3: + B_xx."""
+        order 0: value only, 1: + gradient, 2: + B_ss and B_xs, 3: + B_xx.  Only the samples
+        within the barrier's reach (d < dhat, including any at d <= 0, where b = +inf) enter."""
         key = getattr(self, "_key", None)
         if key is not None and key[1] == F and np.array_equal(key[0], x):
             s = key[2]
         else:
             s = self.advance(x, F)
             self._key = (x.copy(), F, s)
-        pts = self._points(x)
-        d, n = self._phi(pts, s, False)
-        af = np.flatnonzero(np.any(d < self._dh, axis=1))       # faces with active samples
-        pts, d, n = pts[af], d[af], n[af]
-        N, st = self._N[af], self._st[af]
-        b, b1, b2 = (a.reshape(d.shape) for a in log_barrier(d.ravel(), self._dh))
-        kw = self._kappa * self._w[af]
+        P = self._ops.points(x) - s * self._e
+        d, n = self._obs.distance(P, False)
+        act = np.flatnonzero(d < self._dh)
+        d, n, P = d[act], n[act], P[act]
+        b, b1, b2 = log_barrier(d, self._dh)
+        kw = self._kw[act]
         value = float((kw * b).sum()) - F * s
-        gk = (kw * b1)[..., None] * n                           # dB/dp_k  (F, q, 3)
-        grad = np.zeros((self._n, 3))
-        np.add.at(grad, st, np.einsum("fqs,fqd->fsd", N, gk))
+        if order < 1:
+            return s, value, None, None, None, None
+        grad = self._ops.gradient((kw * b1)[:, None] * n, act)          # dB/dp_k scattered
         if order < 2:
-            return s, value, grad.ravel(), None, None, None
-        H = self._phi(pts, s, True)[2]
+            return s, value, grad, None, None, None
+        H = self._obs.distance(P, True)[2]
         ds = -(n @ self._e)
         He = H @ self._e
-        Bss = float((kw * (b2 * ds * ds + b1 * np.einsum("...i,...i->...", He, self._e))).sum())
-        vk = (kw * b2 * ds)[..., None] * n - (kw * b1)[..., None] * He      # d2B/dp_k ds
-        v = np.zeros((self._n, 3))
-        np.add.at(v, st, np.einsum("fqs,fqd->fsd", N, vk))
+        Bss = float((kw * (b2 * ds * ds + b1 * (He @ self._e))).sum())
+        vk = (kw * b2 * ds)[:, None] * n - (kw * b1)[:, None] * He     # d2B/dp_k ds
+        v = self._ops.gradient(vk, act)
         if order < 3:
-            return s, value, grad.ravel(), None, Bss, v.ravel()
-        Hk = (kw * b2)[..., None, None] * n[..., :, None] * n[..., None, :] + (kw * b1)[..., None, None] * H
-        Nf, Hf, stf = N, Hk, st
-        blocks = np.einsum("fqa,fqb,fqij->faibj", Nf, Nf, Hf)
-        rows = 3 * stf[:, :, None, None, None] + np.arange(3)[None, None, :, None, None]
-        cols = 3 * stf[:, None, None, :, None] + np.arange(3)[None, None, None, None, :]
-        shp = blocks.shape
-        Hm = sp.csr_matrix((blocks.ravel(), (np.broadcast_to(rows, shp).ravel(), np.broadcast_to(cols, shp).ravel())),
-                           shape=(3 * self._n, 3 * self._n))
-        return s, value, grad.ravel(), Hm, Bss, v.ravel()
+            return s, value, grad, None, Bss, v
+        Hk = (kw * b2)[:, None, None] * n[:, :, None] * n[:, None, :] + (kw * b1)[:, None, None] * H
+        return s, value, grad, self._ops.hessian(Hk, act), Bss, v
 
     def evaluate(self, x: np.ndarray, lam: float, order: int = 2, u: np.ndarray | None = None) -> PotentialTerms:
         F = lam * self.force
@@ -224,7 +218,7 @@ class FingerContact(TermBase):
             z = sp.csr_matrix((3 * self._n, 3 * self._n)) if order >= 2 else None
             return PotentialTerms(0.0, np.zeros(3 * self._n) if order >= 1 else None, z)
         try:
-            s, value, grad, Hm, Bss, v = self._terms(x, F, 3 if order >= 2 else (2 if order == 1 else 1))
+            s, value, grad, Hm, Bss, v = self._terms(x, F, 3 if order >= 2 else (2 if order == 1 else 0))
         except NoPosition:                                 # infeasible: the solver backs off
             return PotentialTerms(np.inf, None if order == 0 else np.full(3 * self._n, np.nan),
                                   sp.csr_matrix((3 * self._n, 3 * self._n)) if order >= 2 else None)
@@ -288,6 +282,12 @@ class FingerContact(TermBase):
         """The samples: stencils (F, S), basis values N (F, q, S) and rest weights (F, q) [m^2];
         sample point p_fq = sum_s N[f, q, s] x[stencils[f, s]]."""
         return self._st, self._N, self._w
+
+    @property
+    def sample_operator(self) -> SampleOperator:
+        """The samples as a sparse operator (graspdef.contact.sampling.SampleOperator), rows in the
+        (face, sample) order of :attr:`samples`."""
+        return self._ops
 
     def sample_forces(self, x: np.ndarray, F: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """At control points x (n, 3) with the finger pushed by F [N]: the sample points (F, q, 3)

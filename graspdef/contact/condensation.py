@@ -27,17 +27,14 @@ class ForceControlledAdvance:
 
     def derivatives(self, pts, kw, s):
         """(B_s, B_ss, feasible) at advance s for flat sample points pts (k, 3), weights kw (k,)."""
-        d, n = self._obs.distance(pts - s * self._e, False)
+        d, ds, dss = self._obs.axial(pts - s * self._e, self._e)
         if np.any(d <= 0):
             return np.inf, 0.0, False
         act = d < self._dh
         if not act.any():
             return 0.0, 0.0, True
         _, b1, b2 = self._barrier(d[act], self._dh)
-        _, na, Ha = self._obs.distance(pts[act] - s * self._e, True)
-        ds = -(na @ self._e)
-        dss = np.einsum("i,kij,j->k", self._e, Ha, self._e)
-        kw = kw[act]
+        ds, dss, kw = ds[act], dss[act], kw[act]
         return float((kw * b1 * ds).sum()), float((kw * (b2 * ds * ds + b1 * dss)).sum()), True
 
     def solve(self, P: np.ndarray, KW: np.ndarray, F: float) -> float:

@@ -129,7 +129,7 @@ class FingerFriction(TermBase):
         """A ready friction term on ``shell`` (a new object; this specification is unchanged)."""
         t = copy.copy(self)
         t._fc = self.contact.build(shell, ev)
-        t._st, t._N, _ = t._fc.samples
+        t._ops = t._fc.sample_operator
         e = t._fc.closing_axis
         t._Pe = np.eye(3) - np.outer(e, e)
         t._eps = float(self.eps_v if self.eps_v is not None else EPS_V_PER_DHAT * t._fc.gap_reach)
@@ -146,26 +146,24 @@ class FingerFriction(TermBase):
                 return lam
         return self._seen[-1][1] if self._seen else 0.0
 
-    def _points(self, x: np.ndarray) -> np.ndarray:
-        return np.einsum("fqs,fsd->fqd", self._N, x[self._st])
-
     def lag(self, x: np.ndarray, lam: float) -> None:
         """Set the lagged state at control points x (n, 3) and load factor lam: the points p^n, the
         normal force per unit load factor Lam (at lam = 0: that of the full target force) and the
         slip operators A = T^T (I - e e^T) from the fingertip's normal at each sample."""
         F = lam * self._fc.force if lam > 0 else self._fc.force
         pts, fn, nrm = self._fc.sample_forces(x, F)
-        Lam = fn / (lam if lam > 0 else 1.0)
-        T = tangent_basis(nrm)                                         # (F, q, 3, 2)
-        A = np.einsum("fqia,ij->fqaj", T, self._Pe)                    # (F, q, 2, 3)
-        self._lag = (pts.copy(), Lam, A)
+        Lam = fn.ravel() / (lam if lam > 0 else 1.0)
+        act = np.flatnonzero(Lam > 0)                                  # samples in contact
+        T = tangent_basis(nrm.reshape(-1, 3)[act])                     # (k, 3, 2)
+        A = np.einsum("kia,ij->kaj", T, self._Pe)                      # (k, 2, 3)
+        self._lag = (act, pts.reshape(-1, 3)[act].copy(), Lam[act], A)
 
     def _slip(self, x: np.ndarray):
-        """Active faces, their slips u (F', q, 2), Lam (F', q) and A (F', q, 2, 3)."""
-        P, Lam, A = self._lag
-        af = np.flatnonzero(np.any(Lam > 0, axis=1))
-        dp = np.einsum("fqs,fsd->fqd", self._N[af], x[self._st[af]]) - P[af]
-        return af, np.einsum("fqaj,fqj->fqa", A[af], dp), Lam[af], A[af]
+        """The samples in contact at the lagged state (k,), their slips u (k, 2), Lam (k,) and
+        A (k, 2, 3)."""
+        act, P, Lam, A = self._lag
+        dp = self._ops.points(x, act) - P
+        return act, np.einsum("kaj,kj->ka", A, dp), Lam, A
 
     # ---- energy-term protocol ----------------------------------------------------------------
     def evaluate(self, x: np.ndarray, lam: float, order: int = 2, u: np.ndarray | None = None) -> TermValue:
@@ -184,11 +182,8 @@ class FingerFriction(TermBase):
         value = lam * float((c * f0).sum())
         if order == 0:
             return TermValue(value, None, None)
-        gp = np.einsum("fqaj,fqa->fqj", A, (c * f1y)[..., None] * uk)  # dD/dp_k at lam = 1
-        st, N = self._st[af], self._N[af]
-        g1 = np.zeros((self._n, 3))
-        np.add.at(g1, st, np.einsum("fqs,fqd->fsd", N, gp))
-        g1 = g1.ravel()
+        gp = np.einsum("kaj,ka->kj", A, (c * f1y)[:, None] * uk)      # dD/dp_k at lam = 1
+        g1 = self._ops.gradient(gp, af)
         self._unit = (x.copy(), g1)
         if order < 2:
             return TermValue(value, lam * g1, None)
@@ -196,14 +191,9 @@ class FingerFriction(TermBase):
         ysafe = np.where(y > 0, y, 1.0)
         w = np.where(y < self._eps, -1.0 / (self._eps * self._eps * ysafe), -1.0 / ysafe ** 3)
         w = np.where(y > 0, w, 0.0)
-        Hu = (f1y[..., None, None] * np.eye(2) + w[..., None, None] * uk[..., :, None] * uk[..., None, :])
-        Hp = lam * np.einsum("fq,fqai,fqab,fqbj->fqij", c, A, Hu, A)
-        blocks = np.einsum("fqa,fqb,fqij->faibj", N, N, Hp)
-        rows = 3 * st[:, :, None, None, None] + np.arange(3)[None, None, :, None, None]
-        cols = 3 * st[:, None, None, :, None] + np.arange(3)[None, None, None, None, :]
-        shp = blocks.shape
-        H = sp.csr_matrix((blocks.ravel(), (np.broadcast_to(rows, shp).ravel(), np.broadcast_to(cols, shp).ravel())),
-                          shape=(n3, n3))
+        Hu = (f1y[:, None, None] * np.eye(2) + w[:, None, None] * uk[:, :, None] * uk[:, None, :])
+        Hp = lam * np.einsum("k,kai,kab,kbj->kij", c, A, Hu, A)
+        H = self._ops.hessian(Hp, af)
         return TermValue(value, lam * g1, H)
 
     def load(self, x: np.ndarray) -> np.ndarray | None:
@@ -240,8 +230,8 @@ class FingerFriction(TermBase):
         y = np.linalg.norm(uk, axis=-1)
         act = Lam > 0
         _, f1y, _ = mollifier(y, self._eps)
-        fp = -np.einsum("fqaj,fqa->fqj", A, (self.mu * lam * Lam * f1y)[..., None] * uk)   # force on the shell
-        f = fp.reshape(-1, 3).sum(axis=0) if fp.size else np.zeros(3)
+        fp = -np.einsum("kaj,ka->kj", A, (self.mu * lam * Lam * f1y)[:, None] * uk)   # force on the shell
+        f = fp.sum(axis=0) if fp.size else np.zeros(3)
         e = self._fc.closing_axis
         return {"mu": self.mu, "eps_v_m": self._eps, "n_stick": int((act & (y < self._eps)).sum()),
                 "n_slip": int((act & (y >= self._eps)).sum()),

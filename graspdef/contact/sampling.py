@@ -1,11 +1,14 @@
 """Where the contact barrier looks: the faces near a fingertip (:func:`select_faces`) and samples of
 the shell's limit surface on them (:func:`sample_faces`: sub-triangle centroids of each face's
-parameter domain, weighted by their rest area)."""
+parameter domain, weighted by their rest area) and :class:`SampleOperator`, the sparse map from
+control points to those samples that the barrier and the friction term gather and scatter with."""
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import ProblemError
+from ..subdivision.patch import regular_basis
 
 
 def select_faces(shell, obstacle, e: np.ndarray, reach: float | None, depth: float | None,
@@ -51,18 +54,61 @@ def sample_faces(shell, ev, faces: np.ndarray, L: int):
                 pts.append(((i + 2 / 3) / L, (j + 2 / 3) / L))
     pts = np.array(pts)
     X = shell.rest_positions
-    st_l, N_l, w_l = [], [], []
-    for f in faces:
+    faces = np.asarray(faces, dtype=np.int64)
+    reg = ev.is_regular(faces)
+    bases = {}
+    if reg.any():                                   # regular faces share one box-spline basis
+        N, dN, _ = regular_basis(pts)
+        for f, st in zip(faces[reg], ev.regular_stencils(faces[reg])):
+            bases[int(f)] = (st, N, dN)
+    for f in faces[~reg]:
         st, N, dN, _ = ev.basis(int(f), pts)
-        a1 = np.einsum("qs,sd->qd", dN[:, :, 0], X[st])
-        a2 = np.einsum("qs,sd->qd", dN[:, :, 1], X[st])
-        st_l.append(st)
-        N_l.append(N)
-        w_l.append(np.linalg.norm(np.cross(a1, a2), axis=1) / (2 * L * L))
-    S = max(len(s) for s in st_l)
+        bases[int(f)] = (st, N, dN)
+    S = max(len(b[0]) for b in bases.values())
     stn = np.zeros((len(faces), S), np.int64)
     Nn = np.zeros((len(faces), len(pts), S))
-    for k, (s, N) in enumerate(zip(st_l, N_l)):
-        stn[k, : len(s)] = s
-        Nn[k, :, : len(s)] = N
-    return stn, Nn, np.array(w_l)
+    dNn = np.zeros((len(faces), len(pts), S, 2))
+    for k, f in enumerate(faces):
+        st, N, dN = bases[int(f)]
+        stn[k, : len(st)] = st
+        Nn[k, :, : len(st)] = N
+        dNn[k, :, : len(st)] = dN
+    a1 = np.einsum("fqs,fsd->fqd", dNn[..., 0], X[stn])
+    a2 = np.einsum("fqs,fsd->fqd", dNn[..., 1], X[stn])
+    return stn, Nn, np.linalg.norm(np.cross(a1, a2), axis=-1) / (2 * L * L)
+
+
+class SampleOperator:
+    """The samples of :func:`sample_faces` as one sparse matrix S (Q, n), Q = F q rows in (face,
+    sample) order: the sample points are p = S x for control points x (n, 3).
+
+    A term with per-sample values gathers its points with :meth:`points` and scatters its per-sample
+    gradients (k, 3) and 3 x 3 Hessian blocks (k, 3, 3) of a subset of rows back to the control
+    points with :meth:`gradient` and :meth:`hessian` (S^T g and (S (x) I3)^T H (S (x) I3))."""
+
+    def __init__(self, stencils: np.ndarray, N: np.ndarray, n_control: int):
+        F, q, S = N.shape
+        rows = np.repeat(np.arange(F * q), S)
+        cols = np.broadcast_to(stencils[:, None, :], (F, q, S)).ravel()
+        M = sp.csr_matrix((N.ravel(), (rows, cols)), shape=(F * q, n_control))
+        M.eliminate_zeros()                              # the stencils' zero-weight padding
+        self.S, self.n = M, n_control
+
+    def points(self, x: np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
+        """Sample points (Q, 3) of control points x (n, 3), or of ``rows`` only (k, 3)."""
+        return (self.S if rows is None else self.S[rows]) @ x
+
+    def gradient(self, g: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """Per-sample gradients g (k, 3) of ``rows`` (k,) scattered to the control points: (3 n,)."""
+        return np.asarray(self.S[rows].T @ g).ravel()
+
+    def hessian(self, H: np.ndarray, rows: np.ndarray) -> sp.csr_matrix:
+        """Per-sample 3 x 3 Hessian blocks H (k, 3, 3) of ``rows`` (k,) assembled over the control
+        points: the (3 n, 3 n) matrix sum_k (S_k (x) I3)^T H_k (S_k (x) I3)."""
+        k = len(rows)
+        n3 = 3 * self.n
+        if k == 0:
+            return sp.csr_matrix((n3, n3))
+        S3 = sp.kron(self.S[rows], sp.identity(3, format="csr"), format="csr")
+        Hb = sp.bsr_matrix((np.ascontiguousarray(H, dtype=float), np.arange(k), np.arange(k + 1)), shape=(3 * k, 3 * k))
+        return (S3.T @ (Hb.tocsr() @ S3)).tocsr()

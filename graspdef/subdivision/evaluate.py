@@ -28,6 +28,7 @@ class SurfaceEvaluator:
         self._counts = face_counts(self.faces, self.n_control)
         self._inner = interior_mask(self.faces, self.n_control)
         self._cache: dict = {}          # local patches already evaluated (irregular_basis)
+        self._stencils: dict = {}       # face -> its 12-vertex stencil, or None if irregular
 
     def is_regular(self, faces: np.ndarray) -> np.ndarray:
         """True for faces whose three vertices are interior with valence 6 (box-spline patches)."""
@@ -43,10 +44,15 @@ class SurfaceEvaluator:
         if not self._inner[tri].all():
             raise MeshError(f"face {face} has a vertex with an open one-ring: evaluate the ghosted mesh")
         pts = np.atleast_2d(np.asarray(pts, dtype=float))
-        if _is_regular(tri[None], self._counts, self._inner)[0]:
+        face = int(face)
+        if face not in self._stencils:
+            reg = _is_regular(tri[None], self._counts, self._inner)[0]
+            self._stencils[face] = regular_stencils(self._he, tri[None])[0] if reg else None
+        st = self._stencils[face]
+        if st is not None:
             N, dN, ddN = regular_basis(pts)
-            return regular_stencils(self._he, tri[None])[0], N, dN, ddN
-        return irregular_basis(self.faces, self._vf, int(face), pts, self._cache)
+            return st.copy(), N, dN, ddN
+        return irregular_basis(self.faces, self._vf, face, pts, self._cache)
 
     def values(self, face: int, bary: np.ndarray, tol: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
         """Control indices (S,) and weights (S,) of the limit point with barycentric coordinates

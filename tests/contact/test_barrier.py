@@ -79,6 +79,12 @@ def test_obstacle_distance_derivatives(obstacle):
                        scale=1.0, what="grad phi")
         assert_fd_rate(H[:, :, k], fd(h, lambda q: obstacle.distance(q)[1]), fd(h / 2, lambda q: obstacle.distance(q)[1]),
                        scale=np.abs(H).max(), what="Hessian phi")
+    # along an axis (the condensed finger advance's derivatives): the same phi, -n.e and e.H.e
+    e = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
+    phi_a, d1, d2 = obstacle.axial(p, e)
+    assert np.array_equal(phi_a, phi)
+    assert np.allclose(d1, -(n @ e), rtol=1e-14, atol=1e-15)
+    assert np.allclose(d2, np.einsum("i,kij,j->k", e, H, e), rtol=1e-12, atol=1e-12 * np.abs(H).max())
 
 
 @pytest.mark.parametrize("obstacle", [_pin(), _pad()], ids=["pin", "pad"])
@@ -168,3 +174,29 @@ def test_small_pin_matches_point_loads_away_from_contact(shell):
     ring = [band & (np.sign(X[:, 0]) == s) for s in (1, -1)]
     ac, ap = (u[ring[0], 0].mean() - u[ring[1], 0].mean() for u in (uc, up))
     assert ap < 0 and ac == pytest.approx(ap, rel=0.15)
+
+
+def test_sample_operator_gathers_and_scatters_like_the_stencils(shell):
+    """SampleOperator (graspdef.contact.sampling): p = S x equals the stencil sum sum_s N x[st];
+    the gradient it scatters is S^T g and its Hessian is the sum of (S_k (x) I3)^T H_k (S_k (x) I3)
+    -- the same quadratic form g-dual: v.H.v = sum_k (S_k v)^T H_k (S_k v) for any v."""
+    from graspdef.contact.sampling import SampleOperator, sample_faces
+
+    st, N, w = sample_faces(shell, shell.evaluator, np.arange(0, 60, 3), 3)
+    assert np.all(w > 0) and np.all(np.isfinite(N))
+    ops = SampleOperator(st, N, shell.n_control)
+    rng = np.random.default_rng(4)
+    x = shell.rest_positions + rng.normal(size=shell.rest_positions.shape) * 1e-3
+    ref = np.einsum("fqs,fsd->fqd", N, x[st]).reshape(-1, 3)
+    assert np.allclose(ops.points(x), ref, rtol=0, atol=1e-15)
+    rows = np.sort(rng.choice(len(ref), 40, replace=False))
+    assert np.allclose(ops.points(x, rows), ref[rows], rtol=0, atol=1e-15)
+    g = rng.normal(size=(40, 3))
+    v = rng.normal(size=x.shape)
+    Sv = ops.points(v, rows)
+    assert np.isclose(ops.gradient(g, rows) @ v.ravel(), (g * Sv).sum(), rtol=1e-12)
+    Hk = rng.normal(size=(40, 3, 3))
+    Hk = Hk + Hk.transpose(0, 2, 1)
+    H = ops.hessian(Hk, rows)
+    assert H.shape == (3 * shell.n_control,) * 2 and abs(H - H.T).max() < 1e-12 * abs(H).max()
+    assert np.isclose(v.ravel() @ (H @ v.ravel()), np.einsum("ki,kij,kj->", Sv, Hk, Sv), rtol=1e-12)
