@@ -188,10 +188,10 @@ class FingerContact(TermBase):
         else:
             s = self.advance(x, F)
             self._key = (x.copy(), F, s)
-        P = self._ops.points(x) - s * self._e
-        d, n = self._obs.distance(P, False)
+        P = self._ops.points(x)
+        d, n, _, _ = self._obs.along(P, s * self._e, self._e)
         act = np.flatnonzero(d < self._dh)
-        d, n, P = d[act], n[act], P[act]
+        d, n, P = d[act], n[act], P[act] - s * self._e
         b, b1, b2 = log_barrier(d, self._dh)
         kw = self._kw[act]
         value = float((kw * b).sum()) - F * s

@@ -27,7 +27,7 @@ class ForceControlledAdvance:
 
     def derivatives(self, pts, kw, s):
         """(B_s, B_ss, feasible) at advance s for flat sample points pts (k, 3), weights kw (k,)."""
-        d, ds, dss = self._obs.axial(pts - s * self._e, self._e)
+        d, _, ds, dss = self._obs.along(pts, s * self._e, self._e)
         if np.any(d <= 0):
             return np.inf, 0.0, False
         act = d < self._dh
@@ -48,7 +48,7 @@ class ForceControlledAdvance:
         sel = {}
 
         def window(sc):
-            d = self._obs.distance(P - sc * self._e, False)[0]
+            d = self._obs.along(P, sc * self._e, self._e)[0]
             idx = np.flatnonzero(d < self._dh + W)
             sel.update(c=sc, p=P[idx], kw=KW[idx])
 
@@ -59,7 +59,7 @@ class ForceControlledAdvance:
             return (g - F if ok else np.inf), gs, ok
 
         def dmin(t):
-            return float(self._obs.distance(P - t * self._e, False)[0].min())
+            return float(self._obs.along(P, t * self._e, self._e)[0].min())
 
         def bracket(s):
             """(lo, hi): G(lo) < 0 <= G(hi); advancing conservatively (never by more than 0.9 of

@@ -46,20 +46,16 @@ class Capsule:
             P[side] -= np.outer(u, u)[None]
         return r - self.radius, n, P / r[:, None, None]
 
-    def axial(self, p: np.ndarray, e: np.ndarray):
-        """phi (k,) at points p (k, 3) outside the capsule and its first two derivatives when the
-        capsule advances by s along the unit vector e (the points move by -s e): -n.e and e.H.e
-        (k,) -- what the condensed finger advance needs, without the (k, 3, 3) Hessians."""
-        a, b = np.asarray(self.a, float), np.asarray(self.b, float)
-        ab = b - a
-        L2 = ab @ ab
-        t = np.clip(((p - a) @ ab) / L2, 0.0, 1.0)
-        v = p - (a + t[:, None] * ab)
-        r = np.maximum(np.sqrt(np.einsum("ki,ki->k", v, v)), 1e-300)
-        ne = (v @ e) / r
-        side = (t > 0) & (t < 1)
-        ue = (ab @ e) / np.sqrt(L2)
-        return r - self.radius, -ne, (e @ e - ne * ne - np.where(side, ue * ue, 0.0)) / r
+    def along(self, p: np.ndarray, shift: np.ndarray, e: np.ndarray):
+        """At the points p - shift (p (k, 3) outside the capsule): phi (k,), the unit normal (k, 3)
+        and phi's first two derivatives when the capsule advances by s along the unit vector e (the
+        points move by -s e): -n.e and e.H.e (k,) -- what the condensed finger advance needs,
+        without the (k, 3, 3) Hessians (compiled: graspdef.contact._kernels)."""
+        from ._kernels import capsule_distance
+
+        return capsule_distance(np.ascontiguousarray(p, dtype=float), np.asarray(shift, float),
+                                np.asarray(self.a, float), np.asarray(self.b, float), float(self.radius),
+                                np.asarray(e, float))
 
 
 @dataclass(frozen=True)
@@ -105,20 +101,13 @@ class RoundedBox:
         Hl = (D[:, :, None] * np.eye(3)[None] - nl[:, :, None] * nl[:, None, :]) / r[:, None, None]
         return phi, n, R[None] @ Hl @ R.T[None]
 
-    def axial(self, p: np.ndarray, e: np.ndarray):
-        """phi (k,) at points p (k, 3) outside the box and its first two derivatives when the box
-        advances by s along the unit vector e (the points move by -s e): -n.e and e.H.e (k,)."""
-        R = np.asarray(self.rotation, float)
-        c = np.asarray(self.center, float)
-        h = np.asarray(self.half_extents, float) - self.rounding
-        loc = (p - c) @ R
-        el = R.T @ e
-        q = np.abs(loc) - h
-        m = np.maximum(q, 0.0)
-        r = np.sqrt(np.einsum("ki,ki->k", m, m))
-        inside = r <= 0
-        r = np.maximum(r, 1e-300)
-        sm = np.where(loc < 0, -m, m)
-        ne = (sm @ el) / r
-        phi = np.where(inside, q.max(axis=1), r) - self.rounding
-        return phi, -ne, (((q > 0) * el * el).sum(axis=1) - ne * ne) / r
+    def along(self, p: np.ndarray, shift: np.ndarray, e: np.ndarray):
+        """At the points p - shift (p (k, 3) outside the box): phi (k,), the unit normal (k, 3) and
+        phi's first two derivatives when the box advances by s along the unit vector e (the points
+        move by -s e): -n.e and e.H.e (k,) (compiled: graspdef.contact._kernels)."""
+        from ._kernels import box_distance
+
+        return box_distance(np.ascontiguousarray(p, dtype=float), np.asarray(shift, float),
+                            np.asarray(self.center, float), np.asarray(self.rotation, float),
+                            np.asarray(self.half_extents, float) - self.rounding, float(self.rounding),
+                            np.asarray(e, float))

@@ -79,10 +79,13 @@ def test_obstacle_distance_derivatives(obstacle):
                        scale=1.0, what="grad phi")
         assert_fd_rate(H[:, :, k], fd(h, lambda q: obstacle.distance(q)[1]), fd(h / 2, lambda q: obstacle.distance(q)[1]),
                        scale=np.abs(H).max(), what="Hessian phi")
-    # along an axis (the condensed finger advance's derivatives): the same phi, -n.e and e.H.e
+    # the compiled kernel along an axis (the condensed finger advance's derivatives), at points
+    # shifted by s e: the same phi and normal as the numpy method, -n.e and e.H.e
     e = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
-    phi_a, d1, d2 = obstacle.axial(p, e)
-    assert np.array_equal(phi_a, phi)
+    sh = 1.3e-3 * e
+    phi, n, H = obstacle.distance(p - sh)
+    phi_a, n_a, d1, d2 = obstacle.along(p, sh, e)
+    assert np.allclose(phi_a, phi, rtol=0, atol=1e-15) and np.allclose(n_a, n, rtol=0, atol=1e-14)
     assert np.allclose(d1, -(n @ e), rtol=1e-14, atol=1e-15)
     assert np.allclose(d2, np.einsum("i,kij,j->k", e, H, e), rtol=1e-12, atol=1e-12 * np.abs(H).max())
 
