@@ -89,25 +89,64 @@ def _inside(vw: np.ndarray, margin: float = 1e-10) -> np.ndarray:
     return vw
 
 
+def _inside_rows(vw: np.ndarray, margin: float = 1e-10) -> np.ndarray:
+    """:func:`_inside` for each row of vw (m, 2)."""
+    vw = np.clip(vw, 0.0, 1.0)
+    t = vw.sum(axis=1)
+    vw = np.where((t > 1.0)[:, None], vw / np.where(t > 1.0, t, 1.0)[:, None], vw)
+    u = 1.0 - vw.sum(axis=1)
+    near = np.maximum(u, vw.max(axis=1)) > 1.0 - margin
+    return np.where(near[:, None], (1.0 - 3.0 * margin) * vw + margin, vw)
+
+
+def _chart_steps(N: np.ndarray, dN: np.ndarray, X: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Gauss-Newton steps (m, 2) in the charts of m faces: N (m, S), dN (m, S, 2), X (m, S, 3)."""
+    r = np.einsum("ms,msd->md", N, X) - p
+    A = np.einsum("msk,msd->mkd", dN, X)                     # (m, 2, 3): a1, a2
+    M = np.einsum("mkd,mld->mkl", A, A)
+    b = -np.einsum("mkd,md->mk", A, r)
+    out = np.empty_like(b)
+    for i in range(len(b)):                                  # 2 x 2 least squares (as np.linalg.lstsq)
+        out[i] = np.linalg.lstsq(M[i], b[i], rcond=None)[0]
+    return out
+
+
 def project_point(ev: SurfaceEvaluator, x: np.ndarray, target: np.ndarray, candidates: np.ndarray,
                   iterations: int = 12) -> tuple[int, np.ndarray, float]:
     """Closest point of the limit surface (control points ``x``) to ``target`` among the
-    ``candidates`` faces: Gauss-Newton in each face chart, clamped to the triangle.
+    ``candidates`` faces: Gauss-Newton in each face chart, clamped to the triangle (the regular
+    faces' iterations in one batch: they share the box-spline basis).
 
     Returns (face, barycentric (3,), distance)."""
     best = (-1, np.zeros(3), np.inf)
     p = np.asarray(target, dtype=float)
-    for f in np.asarray(candidates, dtype=np.int64):
+    cands = np.asarray(candidates, dtype=np.int64)
+    reg = ev.is_regular(cands) if len(cands) else np.zeros(0, bool)
+    found = {}
+    if reg.any():
+        fr = cands[reg]
+        X = x[ev.regular_stencils(fr)]                      # (m, 12, 3)
+        vw = np.full((len(fr), 2), 1.0 / 3.0)
+        live = np.ones(len(fr), bool)
+        for _ in range(iterations):
+            if not live.any():
+                break
+            N, dN, _ = regular_basis(vw[live])
+            step = _chart_steps(N, dN, X[live], p)
+            vw[live] = _inside_rows(vw[live] + step)
+            live[np.flatnonzero(live)[np.linalg.norm(step, axis=1) < 1e-13]] = False
+        found.update(zip(fr.tolist(), vw))
+    for f in cands[~reg]:
         vw = np.array([1.0 / 3.0, 1.0 / 3.0])
         for _ in range(iterations):
             st, N, dN, _ = ev.basis(int(f), vw[None])
-            X = x[st]
-            r = N[0] @ X - p
-            A = dN[0].T @ X                                  # (2, 3): a1, a2
-            step = np.linalg.lstsq(A @ A.T, -(A @ r), rcond=None)[0]
+            step = _chart_steps(N, dN, x[st][None], p)[0]
             vw = _inside(vw + step)
             if np.linalg.norm(step) < 1e-13:
                 break
+        found[int(f)] = vw
+    for f in cands.tolist():
+        vw = found[f]
         bary = np.array([1.0 - vw.sum(), vw[0], vw[1]])
         d = float(np.linalg.norm(ev.point(x, int(f), bary) - p))
         if d < best[2]:
