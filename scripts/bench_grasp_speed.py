@@ -3,20 +3,26 @@ nonlinear neo-Hookean shell with enclosed air at 21.48 N per finger, each run in
 (numba's cache warm).  Prints each run and the median; saves JSON.
 
     python scripts/bench_grasp_speed.py [--runs 3] [--contact point|geometric] [--scene tennis_ball]
-                                        [--out out/bench_grasp_speed.json]
+                                        [--ref GIT_REF] [--out out/bench_grasp_speed.json]
 
 ``--contact geometric``: the fingertips as rigid obstacles (graspdef.contact.barrier); ``--scene
-scenes/tennis_ball/scene_pad.xml`` for the pads.
+scenes/tennis_ball/scene_pad.xml`` for the pads.  ``--ref GIT_REF``: also run the OLD code of that
+git ref (a temporary worktree), OLD and NEW alternating run by run on the same machine; each
+tree's numba cache is warmed by one untimed run.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
 
 CHILD = r"""
 import json, sys, time
@@ -31,35 +37,66 @@ print(json.dumps({"timings": r["timings_s"], "indentation_mm": r["feedback"]["in
 """
 
 
+def _run(k: int, tree: Path, a) -> dict:
+    """One fresh process of the grasp in ``tree`` (its graspdef on PYTHONPATH)."""
+    t0 = time.perf_counter()
+    env = dict(os.environ, PYTHONPATH=str(tree))
+    env.setdefault("GRASPDEF_SHARED_SCANS", str(ROOT.parent / "shared" / "scans"))   # the OLD tree's ../shared is not there
+    res = subprocess.run([sys.executable, "-c", CHILD, f"out/bench_grasp_run{k}", a.contact, a.scene], capture_output=True,
+                         text=True, cwd=tree, env=env)
+    if res.returncode:
+        print(res.stderr[-3000:], file=sys.stderr)
+        raise SystemExit(f"run {k} in {tree} failed")
+    r = json.loads(res.stdout.strip().splitlines()[-1])
+    r["wall_s"] = time.perf_counter() - t0
+    return r
+
+
+def _show(label: str, k: int, r: dict) -> None:
+    print(f"{label} run {k}: wall {r['wall_s']:.1f} s; " + ", ".join(f"{n} {v:.1f} s" for n, v in r["timings"].items()) +
+          f"; indentation {r['indentation_mm']:.4f} mm; {r['factorisations']} factorisations" +
+          ("" if r["completed"] else " -- PATH STOPPED before the full force (not a valid timing)"), flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--out", default="out/bench_grasp_speed.json")
     ap.add_argument("--contact", default="point", choices=["point", "geometric"])
     ap.add_argument("--scene", default="tennis_ball")
+    ap.add_argument("--ref", default=None, help="git ref of OLD code to run beside the working tree's")
     a = ap.parse_args()
-    runs = []
-    for k in range(a.runs + 1):                      # run 0 warms numba's on-disk cache
-        t0 = time.perf_counter()
-        res = subprocess.run([sys.executable, "-c", CHILD, f"out/bench_grasp_run{k}", a.contact, a.scene], capture_output=True, text=True)
-        if res.returncode:
-            print(res.stderr[-3000:], file=sys.stderr)
-            raise SystemExit(f"run {k} failed")
-        r = json.loads(res.stdout.strip().splitlines()[-1])
-        r["wall_s"] = time.perf_counter() - t0
-        print(f"run {k}{' (warm-up)' if k == 0 else ''}: wall {r['wall_s']:.1f} s; " +
-              ", ".join(f"{n} {v:.1f} s" for n, v in r["timings"].items()) +
-              f"; indentation {r['indentation_mm']:.2f} mm" +
-              ("" if r["completed"] else " -- PATH STOPPED before the full force (not a valid timing)"), flush=True)
-        if k:
-            runs.append(r)
-    if not all(r["completed"] for r in runs):
-        raise SystemExit("some runs stopped before the full force: their times are not comparable")
-    med = statistics.median(r["wall_s"] for r in runs)
-    print(f"median wall time over {a.runs} runs: {med:.1f} s (target 30 s)")
+    trees = {"NEW": ROOT}
+    tmp = None
+    if a.ref:
+        commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", a.ref], capture_output=True, text=True,
+                                check=True).stdout.strip()
+        tmp = Path(tempfile.mkdtemp(prefix="bench_grasp_"))
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tmp / "old"), commit],
+                       capture_output=True, check=True)
+        trees = {"OLD": tmp / "old", "NEW": ROOT}
+    runs: dict[str, list] = {k: [] for k in trees}
+    try:
+        for label, tree in trees.items():            # warm each tree's numba on-disk cache (not timed)
+            _show(label + " (warm-up)", 0, _run(0, tree, a))
+        for k in range(1, a.runs + 1):
+            for label, tree in trees.items():
+                r = _run(k, tree, a)
+                runs[label].append(r)
+                _show(label, k, r)
+    finally:
+        if tmp is not None:
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tmp / "old")], capture_output=True)
+    med = {}
+    for label, rs in runs.items():
+        if not all(r["completed"] for r in rs):
+            raise SystemExit(f"{label}: some runs stopped before the full force: their times are not comparable")
+        med[label] = statistics.median(r["wall_s"] for r in rs)
+        print(f"{label}: median wall time over {a.runs} runs: {med[label]:.1f} s (indentation "
+              f"{rs[0]['indentation_mm']:.4f} mm, {rs[0]['factorisations']} factorisations)")
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(a.out).write_text(json.dumps({"contact": a.contact, "scene": a.scene, "runs": runs, "median_wall_s": med},
-                                      indent=2) + "\n")
+    Path(a.out).write_text(json.dumps({"contact": a.contact, "scene": a.scene, "ref": a.ref, "runs": runs,
+                                       "median_wall_s": med}, indent=2) + "\n")
 
 
 if __name__ == "__main__":
