@@ -18,6 +18,17 @@ it first thing, before any solve (it only helps speed, never changes a result):
   is too old for it (a warning), so numba runs on OpenMP anyway.  ``NUMBA_THREADING_LAYER=omp``
   states that choice (the same layer in every process, whatever was imported first, and no warning).
 
+* **OpenBLAS's threads.**  numpy's and SciPy's OpenBLAS start one thread per core; graspdef's
+  dense work is small (vector dots and norms of the solvers, 2 x 2 to 100 x 100 least squares,
+  the supports' QR), where the threads cost more than they give and, on a busy machine, spin
+  against PARDISO and numba for the cores (a 30k-vector dot took 15 ms instead of 50 us).
+  ``OPENBLAS_NUM_THREADS=1`` is set unless the user has set it (PARDISO's MKL threads and numba's
+  are separate and keep both cores).  Measured 2026-11-26, 2 cores, alternating runs, medians of
+  3: the linear 10k pinched cylinder's assembly 0.94 -> 0.57 s, the 2,562-vertex ball's nonlinear
+  path 4.7 -> 4.2 s, the tennis-ball pad grasp 14.6 -> 13.6 s, every result the same.  Like the
+  others it must be set before numpy is first imported (the command line calls configure before
+  any numerical import; ``blas_threads_fixed`` in the returned dict says whether it was in time).
+
 All only fill in environment variables the user has not set.
 """
 from __future__ import annotations
@@ -38,9 +49,11 @@ def locate_mkl_rt() -> str | None:
 
 
 def configure() -> dict:
-    """Set the OpenMP wait policy and numba's threading layer (unless set) and locate MKL's runtime;
-    returns what is in effect."""
+    """Set the OpenMP wait policy, numba's threading layer and OpenBLAS's thread count (unless set)
+    and locate MKL's runtime; returns what is in effect."""
     os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
     os.environ.setdefault("NUMBA_THREADING_LAYER", "omp")
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     return {"OMP_WAIT_POLICY": os.environ["OMP_WAIT_POLICY"], "NUMBA_THREADING_LAYER": os.environ["NUMBA_THREADING_LAYER"],
+            "OPENBLAS_NUM_THREADS": os.environ["OPENBLAS_NUM_THREADS"], "blas_threads_fixed": "numpy" not in sys.modules,
             "PYPARDISO_MKL_RT": locate_mkl_rt()}

@@ -164,3 +164,21 @@ def test_lazy_imports_change_no_number(lazy_plate, tmp_path):
     assert lazy["probes"] == eager["probes"]
     assert lazy["derived"]["max_displacement"] == eager["derived"]["max_displacement"]
     assert (out / "deformed.ply").read_bytes() == (tmp_path / "eager" / "deformed.ply").read_bytes()
+
+
+def test_configure_fixes_openblas_threads_unless_the_user_did():
+    """graspdef.runtime.configure sets OPENBLAS_NUM_THREADS=1 when it is unset, keeps a user's
+    value, and says whether it came before numpy's first import (only then does OpenBLAS read it)."""
+    code = ("import json, os\nfrom graspdef import runtime\n{pre}r = runtime.configure()\n"
+            "print(json.dumps([os.environ['OPENBLAS_NUM_THREADS'], r['OPENBLAS_NUM_THREADS'], r['blas_threads_fixed']]))")
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+
+    def run(pre="", extra=None):
+        r = subprocess.run([sys.executable, "-c", code.format(pre=pre)], capture_output=True, text=True,
+                           env=env | (extra or {}), cwd=ROOT, check=False)
+        assert r.returncode == 0, r.stderr
+        return json.loads(r.stdout.strip().splitlines()[-1])
+
+    assert run() == ["1", "1", True]
+    assert run(extra={"OPENBLAS_NUM_THREADS": "2"}) == ["2", "2", True]
+    assert run(pre="import numpy\n") == ["1", "1", False]
