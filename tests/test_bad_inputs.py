@@ -259,6 +259,12 @@ def _case(name: str, tmp: Path) -> tuple[list[str], str]:
                                              "-1,2\n"), "--params", "E", "--out", out], "force must be positive"),
         "fit: fewer rows than parameters": lambda: (["fit", "tennis_ball", "--data", _file(
             tmp, "d.csv", "force_N,displacement_mm\n10,2\n"), "--params", "E,pressure", "--out", out], "1 rows for 2"),
+        "fit: --align-region without --scan": lambda: (["fit", "tennis_ball", "--data", _file(
+            tmp, "d.csv", "force_N,displacement_mm\n10,2\n"), "--params", "E", "--align-region", "z < 0", "--out", out],
+            "--align-region belongs to --scan"),
+        "fit: bad --align-region": lambda: (["fit", "tennis_ball", "--scan", _file(tmp, "s.xyz", "0 0 0\n"), "--force",
+                                             "10N", "--params", "E", "--align-region", "zz < 0", "--out", out],
+                                            "alignment region"),
         # --- bench
         "bench: missing folder": lambda: (["bench", "linear", "--dir", str(tmp / "nowhere")], "nowhere"),
     }
@@ -286,7 +292,7 @@ NAMES = sorted([
     "rank: unknown object", "rank: --out holds other files", "rank: force range reversed",
     "rank: force and force range", "rank: force beyond the gripper",
     "fit: missing data file", "fit: header without units", "fit: unknown parameter", "fit: non-positive force",
-    "fit: fewer rows than parameters"])
+    "fit: fewer rows than parameters", "fit: --align-region without --scan", "fit: bad --align-region"])
 
 
 def test_the_matrix_has_at_least_30_classes():

@@ -26,6 +26,10 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--force", help="with --scan: the force per finger the scan was taken at, e.g. 21.48N")
     ap.add_argument("--near", default="20mm", help="with --scan: radius around the load points whose scan points are "
                     "fitted (20mm)")
+    ap.add_argument("--align-region", dest="align_region",
+                    help="with --scan: align the scan only on this part of the predicted surface, one that stays "
+                         "undeformed (a predicate of x, y, z, r, rho, theta in mm, object frame, e.g. 'abs(z) < 10'; "
+                         "as graspdef score --region); default: the whole surface")
     ap.add_argument("--scan-sigma", dest="scan_sigma", help="with --scan: the scan's noise, e.g. 0.1mm (weights and "
                     "standard errors; default: unweighted)")
     ap.add_argument("--params", required=True, help="parameters to fit, comma-separated: E, pressure (the enclosed "
@@ -74,9 +78,10 @@ def run(a: argparse.Namespace) -> int:
     if (a.data is None) == (scan is None):
         raise ProblemError("give exactly one of --data (a force-displacement table) and --scan (a deformed scan)")
     if scan is None:
-        for opt in ("force", "scan_units", "scan_sigma"):
+        for opt in ("force", "scan_units", "scan_sigma", "align_region"):
             if getattr(a, opt, None) is not None:
-                raise ProblemError(f"--{opt.replace('_', '-')} belongs to --scan (the table gives its own forces)")
+                why = " (the table gives its own forces)" if opt == "force" else ""
+                raise ProblemError(f"--{opt.replace('_', '-')} belongs to --scan{why}")
         r = fit_object(a.scene, a.data, a.params, a.analysis, a.out, a.start, a.max_iterations,
                        progress=lambda msg: progress(a, msg), model=model, patch_size=size)
     else:
@@ -89,7 +94,7 @@ def run(a: argparse.Namespace) -> int:
         sigma = quantity(a.scan_sigma, "length", what="--scan-sigma") if a.scan_sigma is not None else None
         r = fit_object_scan(a.scene, scan, force, a.params, a.analysis, a.out, a.start, a.max_iterations,
                             scan_units=a.scan_units, near=near, sigma=sigma, progress=lambda msg: progress(a, msg),
-                            model=model, patch_size=size)
+                            model=model, patch_size=size, region=a.align_region)
         return _print_scan(a, r)
     doc = r.to_json()
     state = "converged" if r.converged else "NOT CONVERGED"
@@ -130,6 +135,9 @@ def _print_scan(a, r) -> int:
     print(f"{m.get('object', a.scene)}: {a.analysis} shell, deformed scan {m.get('scan_file')} at "
           f"{m.get('force_N', float('nan')):g} N; {len(r.table)} scan points within {passes[-1]['near_m'] * 1e3:g} mm of "
           f"the load points; {state} ({r.message}); {len(passes)} registration pass(es), {r.seconds:.1f} s")
+    if m.get("alignment_region_mm"):
+        counts = " / ".join(str((p.get("registration") or {}).get("n_region_points")) for p in passes)
+        print(f"aligned on the region {m['alignment_region_mm']} (mm): {counts} scan points per pass")
     _print_parameters(r)
     d = np.abs(r.predicted)
     print(f"scan-to-surface distance: RMS {r.rms * 1e3:.4g} mm, median {np.median(d) * 1e3:.4g} mm, "

@@ -91,11 +91,14 @@ def _unit(name: str) -> float:
 def fit_object_scan(scene, scan, force: float, params: str, analysis: str = "nonlinear", out=None,
                     start: str | None = None, max_iterations: int = 30, scan_units: str | None = None,
                     near: float = 0.02, sigma: float | None = None, progress: Callable[[str], None] | None = None,
-                    model: str = "full", patch_size: float = 0.045, passes: int = 2) -> FitResult:
+                    model: str = "full", patch_size: float = 0.045, passes: int = 2,
+                    region: str | None = None) -> FitResult:
     """Fit ``params`` of the object of ``scene`` to a deformed scan (a mesh file, ``scan_units`` if
     it states none) taken at ``force`` [N] per finger (graspdef.fit.scan: registered onto the
     predicted outer surface, the points within ``near`` [m] of the load points kept, their signed
-    distances fitted; ``sigma`` [m]: the scan's noise).  ``out``: the folder for fit.json."""
+    distances fitted; ``sigma`` [m]: the scan's noise; ``region``: align only on this part of the
+    predicted surface, a predicate of x, y, z, r, rho, theta in mm in the object's frame, e.g.
+    ``"abs(z) < 10"``, as ``graspdef score --region``).  ``out``: the folder for fit.json."""
     from ..registration.score import read_scan
     from ..runs.folder import atomic_folder, check_output_folder
     from .models import ObjectModel
@@ -116,6 +119,14 @@ def fit_object_scan(scene, scan, force: float, params: str, analysis: str = "non
         raise ProblemError(f"--scan-sigma must be a positive length, got {sigma!r} m")
     if not (isinstance(near, (int, float)) and math.isfinite(near) and near > 0):
         raise ProblemError(f"--near must be a positive length, got {near!r} m")
+    align = None
+    if region is not None:
+        from ..geometry.regions import compile_predicate
+
+        in_mm = compile_predicate(region, "alignment region (--align-region)", length_scale=1e-3)
+
+        def align(v):
+            return in_mm(np.asarray(v) / 1e-3)
     names = parse_names(params)
     given = parse_start(start, names)
     points = read_scan(scan, scan_units)
@@ -149,9 +160,10 @@ def fit_object_scan(scene, scan, force: float, params: str, analysis: str = "non
         say(f"evaluation {info['evaluations']}: {th}: RMS distance {info['rms_m'] * 1e3:.4g} mm")
 
     result, sels = fit_scan(surface, points, loads, float(force), theta0, near=near, sigma=sigma, passes=passes,
-                            max_nfev=max_iterations, progress=step)
+                            max_nfev=max_iterations, progress=step, region=align)
     result.model.update({k: v for k, v in om.description.items() if k not in result.model})
     result.model["scan_file"] = str(scan)
+    result.model["alignment_region_mm"] = region
     if out is not None:
         with atomic_folder(out) as tmp:
             (Path(tmp) / FIT_FILE).write_text(json.dumps(result.to_json(), indent=2) + "\n")

@@ -5,7 +5,10 @@ Procedure (lengths in metres, the object's frame), :func:`fit_scan`:
 
 1. the whole scan is registered rigidly (graspdef.registration.register) onto the predicted outer
    surface at the start parameters -- the dents help fix the pose, which matters for a ball, whose
-   undeformed part fixes no rotation;
+   undeformed part fixes no rotation; or, with ``region``, its fine alignment uses only the scan
+   points whose closest predicted point lies in that region (one known to stay undeformed, Tian &
+   Jia 2010, Sec. IX, as ``graspdef score --region``): then a start far from the fit (dents much too
+   deep or too shallow) cannot pull the pose;
 2. the scan points within ``near`` of a load point are kept (at most ``max_points``, a seeded
    subsample): the deformed region, where the parameters show;
 3. with that pose fixed, the parameters are fitted (graspdef.fit.fit): per parameter set the
@@ -75,10 +78,12 @@ def check_scan(points) -> np.ndarray:
 
 
 def prepare_scan(points, target: TriMesh | None, load_points, *, near: float, max_points: int = 800,
-                 seed: int = 0, init="pca", min_fitness: float = 0.5) -> ScanSelection:
+                 seed: int = 0, init="pca", min_fitness: float = 0.5, region=None) -> ScanSelection:
     """Register the scan ``points`` (n, 3) [m] onto ``target`` (a predicted outer surface, object
     frame; None: the scan is already in the object's frame) and keep the points within ``near`` [m]
-    of a load point (see the module docstring).  Bad input: ProblemError, one line."""
+    of a load point (see the module docstring).  ``region``: a predicate of the target's vertices
+    (n, 3) [m] -> bool, the part to align on (graspdef.registration.register).  Bad input:
+    ProblemError or RegistrationError, one line."""
     pts = check_scan(points)
     lp = np.asarray(load_points, dtype=float).reshape(-1, 3)
     if not (np.isfinite(near) and near > 0):
@@ -89,9 +94,10 @@ def prepare_scan(points, target: TriMesh | None, load_points, *, near: float, ma
     if target is not None:
         from ..registration.icp import apply, register
 
-        r = register(pts, target, init=init, min_fitness=min_fitness)
+        r = register(pts, target, init=init, min_fitness=min_fitness, region=region)
         T = r.transform
-        reg = {"fitness": r.fitness, "converged": r.converged, "init": r.init, "flags": list(r.flags)}
+        reg = {"fitness": r.fitness, "converged": r.converged, "init": r.init, "flags": list(r.flags),
+               "n_region_points": r.n_region_points}
         pts = apply(T, pts)
     d = np.min(np.linalg.norm(pts[:, None, :] - lp[None, :, :], axis=2), axis=1)
     keep = np.flatnonzero(d < near)
@@ -136,12 +142,13 @@ class ScanModel:
 def fit_scan(surface: Callable[[dict], TriMesh], points, load_points, force: float, start: dict, *,
              offset: float = 0.0, near: float, sigma: float | None = None, register: bool = True,
              passes: int = 2, max_points: int = 800, seed: int = 0, init="pca", max_nfev: int = 30,
-             progress: Callable[[dict], None] | None = None):
+             region=None, progress: Callable[[dict], None] | None = None):
     """Fit ``start``'s parameters to a deformed scan (module docstring): ``surface(theta)`` the
     predicted mid-surface (object frame), ``points`` the scan [m], ``load_points`` (k, 3) [m],
     ``force`` [N] per finger (the table's), ``offset`` [m] to the outer side, ``sigma`` [m] the
-    scan's noise.  Returns (FitResult, [ScanSelection per pass]); the FitResult's model
-    description holds every pass's registration and how far the pose moved between passes."""
+    scan's noise, ``region`` a predicate of surface points [m] -> bool: align on that region only.
+    Returns (FitResult, [ScanSelection per pass]); the FitResult's model description holds every
+    pass's registration and how far the pose moved between passes."""
     from .estimate import fit
     from ..registration.icp import rotation_angle
 
@@ -158,7 +165,7 @@ def fit_scan(surface: Callable[[dict], TriMesh], points, load_points, force: flo
         # the first pass registers onto the start's prediction, which may be far off (dents three
         # times too deep): it accepts a smaller overlap; the last pass needs the usual 50 %
         sel = prepare_scan(pts, target, load_points, near=near, max_points=max_points, seed=seed, init=init,
-                           min_fitness=FIRST_PASS_MIN_FITNESS if k < passes - 1 else 0.5)
+                           min_fitness=FIRST_PASS_MIN_FITNESS if k < passes - 1 else 0.5, region=region)
         sels.append(sel)
         model = ScanModel(surface, sel, offset)
         res = fit(model, scan_table(sel, force, sigma), theta, max_nfev=max_nfev, progress=progress)
