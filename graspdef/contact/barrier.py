@@ -149,7 +149,6 @@ class FingerContact(TermBase):
         self._shell, self._ev = shell, ev
         x_s = self._points(X)
         phi = self._phi(x_s, 0.0, False)[0]
-        self._first = int(np.argmin(phi))
         if phi.min() <= -0.5 * self._obs.feature_radius:
             raise ProblemError(f"finger contact '{self.name}': the fingertip starts {-phi.min():.3g} m inside the shell "
                                "(its reference position must touch the outer surface)")
@@ -178,12 +177,14 @@ class FingerContact(TermBase):
     def scaled(self) -> bool:
         return True
 
-    def _terms(self, x, F, order):
+    def _terms(self, x, F, order, s_at=None):
         """(s*, value, gradient (3n,), Hessian B_xx or None, B_ss, B_xs (3n,)) at force F > 0;
         order 0: value only, 1: + gradient, 2: + B_ss and B_xs, 3: + B_xx.  Only the samples
         within the barrier's reach (d < dhat, including any at d <= 0, where b = +inf) enter."""
         key = getattr(self, "_key", None)
-        if key is not None and key[1] == F and np.array_equal(key[0], x):
+        if s_at is not None:                                    # a given advance (the first touch)
+            s = s_at
+        elif key is not None and key[1] == F and np.array_equal(key[0], x):
             s = key[2]
         else:
             s = self.advance(x, F)
@@ -231,16 +232,19 @@ class FingerContact(TermBase):
 
     def load(self, x: np.ndarray) -> np.ndarray:
         """-d(grad Pi)/d lam = -B_xs F_target / B_ss at the force of the last evaluation; with no
-        push yet, the target force at the sample that the finger meets first."""
+        push yet, the same at the first touch: the fingertip retracted by dhat / 2 from where it
+        touches x, so that the samples within its barrier's reach share the force (the load path's
+        first predictor; a single sample's point force would start a pad's path from a dimple)."""
         last = getattr(self, "_last", None)
         F = last[1] if last is not None and np.array_equal(last[0], x) else None
         if self.force == 0:
             return np.zeros(3 * self._n)
         if F is None or F <= 0:
-            q = np.zeros((self._n, 3))
-            f, k = divmod(self._first, self._N.shape[1])
-            np.add.at(q, self._st[f], self._N[f, k][:, None] * (self.force * self._e)[None])
-            return q.ravel()
+            # the condensed load of a fingertip that just touches: retracted by dhat / 2 from the
+            # first touch, where the samples within its barrier's reach carry a small force
+            s = self.touch(x) - 0.5 * self._dh
+            _, _, _, _, Bss, v = self._terms(x, 0.0, 2, s_at=s)
+            return condensed_load(Bss, v, self.force)
         if last[2] is not None:
             Bss, v = last[2]
         else:
@@ -260,7 +264,7 @@ class FingerContact(TermBase):
         P = self._points(x).reshape(-1, 3)
         s = self._s0
         for _ in range(10000):
-            dm = float(self._obs.distance(P - s * self._e, False)[0].min())
+            dm = float(self._obs.along(P, s * self._e, self._e)[0].min())
             if dm <= tol:
                 return s
             s += dm
