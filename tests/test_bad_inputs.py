@@ -265,6 +265,9 @@ def _case(name: str, tmp: Path) -> tuple[list[str], str]:
         "fit: bad --align-region": lambda: (["fit", "tennis_ball", "--scan", _file(tmp, "s.xyz", "0 0 0\n"), "--force",
                                              "10N", "--params", "E", "--align-region", "zz < 0", "--out", out],
                                             "alignment region"),
+        "fit: negative --scan-sigma": lambda: (["fit", "tennis_ball", "--scan", _file(tmp, "s.xyz", "0 0 0\n"), "--force",
+                                                "10N", "--params", "E", "--scan-sigma=-1mm", "--out", out],
+                                               "--scan-sigma must be a positive length, got -1mm"),
         # --- bench
         "bench: missing folder": lambda: (["bench", "linear", "--dir", str(tmp / "nowhere")], "nowhere"),
     }
@@ -292,7 +295,8 @@ NAMES = sorted([
     "rank: unknown object", "rank: --out holds other files", "rank: force range reversed",
     "rank: force and force range", "rank: force beyond the gripper",
     "fit: missing data file", "fit: header without units", "fit: unknown parameter", "fit: non-positive force",
-    "fit: fewer rows than parameters", "fit: --align-region without --scan", "fit: bad --align-region"])
+    "fit: fewer rows than parameters", "fit: --align-region without --scan", "fit: bad --align-region",
+    "fit: negative --scan-sigma"])
 
 
 def test_the_matrix_has_at_least_30_classes():

@@ -92,6 +92,9 @@ def run(a: argparse.Namespace) -> int:
         force = quantity(a.force, "force", what="--force")
         near = quantity(a.near, "length", what="--near")
         sigma = quantity(a.scan_sigma, "length", what="--scan-sigma") if a.scan_sigma is not None else None
+        for opt, text, v in (("--near", a.near, near), ("--scan-sigma", a.scan_sigma, sigma)):
+            if v is not None and not v > 0:                  # the user's own words, not metres
+                raise ProblemError(f"{opt} must be a positive length, got {text}")
         r = fit_object_scan(a.scene, scan, force, a.params, a.analysis, a.out, a.start, a.max_iterations,
                             scan_units=a.scan_units, near=near, sigma=sigma, progress=lambda msg: progress(a, msg),
                             model=model, patch_size=size, region=a.align_region)
