@@ -18,9 +18,10 @@ import os
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from _trees import code_trees       # scripts/_trees.py: the working tree and --ref's worktree
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -66,17 +67,8 @@ def main() -> None:
     ap.add_argument("--scene", default="tennis_ball")
     ap.add_argument("--ref", default=None, help="git ref of OLD code to run beside the working tree's")
     a = ap.parse_args()
-    trees = {"NEW": ROOT}
-    tmp = None
-    if a.ref:
-        commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", a.ref], capture_output=True, text=True,
-                                check=True).stdout.strip()
-        tmp = Path(tempfile.mkdtemp(prefix="bench_grasp_"))
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tmp / "old"), commit],
-                       capture_output=True, check=True)
-        trees = {"OLD": tmp / "old", "NEW": ROOT}
-    runs: dict[str, list] = {k: [] for k in trees}
-    try:
+    with code_trees(ROOT, a.ref, "bench_grasp_") as trees:
+        runs: dict[str, list] = {k: [] for k in trees}
         for label, tree in trees.items():            # warm each tree's numba on-disk cache (not timed)
             _show(label + " (warm-up)", 0, _run(0, tree, a))
         for k in range(1, a.runs + 1):
@@ -84,9 +76,6 @@ def main() -> None:
                 r = _run(k, tree, a)
                 runs[label].append(r)
                 _show(label, k, r)
-    finally:
-        if tmp is not None:
-            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tmp / "old")], capture_output=True)
     med = {}
     for label, rs in runs.items():
         if not all(r["completed"] for r in rs):

@@ -25,9 +25,10 @@ import os
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from _trees import code_trees       # scripts/_trees.py: the working tree and --ref's worktree
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -115,17 +116,8 @@ def main() -> None:
                     help="PathOptions.krylov: GMRES iterations of an inexact Newton step before a fresh factorisation "
                          "(0: none, the solver's default; code without the option ignores it)")
     a = ap.parse_args()
-    trees = {"NEW": ROOT}
-    tmp = None
-    if a.ref:
-        commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", a.ref], capture_output=True, text=True,
-                                check=True).stdout.strip()
-        tmp = Path(tempfile.mkdtemp(prefix="bench_nonlinear_"))
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tmp / "old"), commit],
-                       capture_output=True, check=True)
-        trees = {"OLD": tmp / "old", "NEW": ROOT}
-    runs: dict[str, list] = {k: [] for k in trees}
-    try:
+    with code_trees(ROOT, a.ref, "bench_nonlinear_") as trees:
+        runs: dict[str, list] = {k: [] for k in trees}
         for tree in trees.values():            # warm numba's on-disk cache of each tree (not timed)
             _run(argparse.Namespace(**{**vars(a), "subdivisions": 2, "steps": 2}), tree)
         for k in range(a.runs):
@@ -133,9 +125,6 @@ def main() -> None:
                 r = _run(a, tree)
                 runs[label].append(r)
                 _show(label, k, r)
-    finally:
-        if tmp is not None:
-            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tmp / "old")], capture_output=True)
     keys = ("path_s", "setup_s", "total_s", "factor_s", "factorisations", "steps")
     med = {label: {key: statistics.median(r[key] for r in rs) for key in keys} for label, rs in runs.items()}
     for label, m in med.items():
