@@ -11,7 +11,8 @@ DESCRIPTION = ("Close the scene's gripper to the force per finger, settle, map t
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("scene", help="scene.xml, its folder, or a name under scenes/ (e.g. tennis_ball)")
-    ap.add_argument("--force", type=float, required=True, help="squeezing force per finger [N]")
+    ap.add_argument("--force", required=True, help="squeezing force per finger, e.g. 21.48 or 21.48N (a plain number "
+                    "is in N)")
     ap.add_argument("--contact", choices=["point", "geometric"], default="point",
                     help="point loads (the paper's model) or geometric: the fingertips as rigid, force-controlled, "
                          "penetration-free obstacles (contact area grows with the load)")
@@ -94,6 +95,7 @@ def run(a: argparse.Namespace) -> int:
     gas = {"auto": None, "on": True, "off": False}[a.gas]
     from ..units import quantity
 
+    force = quantity(a.force, "force", implied="N", what="--force")
     E = None if getattr(a, "E_MPa", None) is None else quantity(a.E_MPa, "pressure", implied="MPa", what="--E-MPa")
     bar = _Progress(a)
     scene = a.scene
@@ -111,7 +113,7 @@ def run(a: argparse.Namespace) -> int:
     patch_size = 0.045
     if model == "patch":
         patch_size = quantity(getattr(a, "patch_size", "45mm"), "length", what="--patch-size")
-    run = run_grasp(scene, a.force, a.contact, a.analysis, a.out, gas=gas, E=E, progress=bar, fingertips=tips,
+    run = run_grasp(scene, force, a.contact, a.analysis, a.out, gas=gas, E=E, progress=bar, fingertips=tips,
                     friction=getattr(a, "friction", None), model=model, patch_size=patch_size)
     bar._end()                                           # close an open progress line before the summary
     r = run.result
