@@ -40,6 +40,8 @@ def test_bad_input_leaves_nothing(tmp_path, capsys):
     assert not out.exists()
     assert grasp_cli(["no_such_scene", "--force", "5", "--out", str(out)]) == 2
     assert grasp_cli(["tennis_ball", "--force", "nan", "--contact", "geometric", "--out", str(out)]) == 2
+    assert "--force must be finite, got 'nan'" in capsys.readouterr().err      # parsed with its unit (N implied)
+    assert grasp_cli(["tennis_ball", "--force=-3N", "--out", str(out)]) == 2
     assert "positive number of newtons" in capsys.readouterr().err
     with pytest.raises(GraspdefError, match="contact must be"):
         run_grasp("tennis_ball", 5.0, "pressure", "linear", out)
