@@ -87,8 +87,10 @@ def build(n: int, amplitude: float, width: float = DIMPLE_L):
     ev = shell.evaluator
     a = locate(shell, ev, np.array([R - amplitude, 0.0, L / 2]), "A", tol=0.2 * R)[0]
     b = locate(shell, ev, np.array([0.0, R, L / 2]), "B", tol=0.2 * R)[0]
-    # one collocation point per supported edge: with two, the 96 x 96 model's KKT matrix has one
-    # negative pivot too many (nearly dependent rows where the diaphragm meets the symmetry edges)
+    # one collocation point per supported edge (the recorded results).  With two, the 96 x 96
+    # model's KKT matrix once counted one negative pivot too many: PARDISO's improved matching
+    # on the re-based support rows, not the model (graspdef.solve.sparse._PARDISO_ROBUST; it now
+    # solves, tests/solve/test_kkt_robust.py)
     pr = Problem(shell, [PointLoad(a.face, a.bary, (-0.25, 0.0, 0.0))], supports, {"A": a, "B": b},
                  n_collocation=1)
     # the dimple's depth on the limit surface: the load point's radius against the unperturbed B's

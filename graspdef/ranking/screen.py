@@ -87,8 +87,9 @@ class LinearScreen:
         self.K = rest_stiffness(self.problem)
         self.kkt = KKTSystem(C, backend)
         self.kkt.factor(self.K)
-        if self.kkt.n_negative is not None and self.kkt.n_negative != self.kkt.m:
-            raise ProblemError(f"the object's rest stiffness is singular beyond its rigid modes ({self.kkt.n_negative} "
+        neg = self.kkt.negative_pivots(self.kkt.m)
+        if neg is not None and neg != self.kkt.m:
+            raise ProblemError(f"the object's rest stiffness is singular beyond its rigid modes ({neg} "
                                f"negative pivots for {self.kkt.m} constraints): a mechanism is free")
         x = shell.rest_positions
         self.samples = limit_samples(mesh.faces, mesh.n_control, level_for(mesh.n_control) if level is None else level)

@@ -167,7 +167,9 @@ class Equilibrium:
         self.kkt.factor(state.hessian)
         self.n_factorisations += 1
         self._lowrank = None
-        neg = self.kkt.n_negative
+        robust = self.kkt.robust
+        neg = self.kkt.negative_pivots(self.m)      # an unexpected inertia is checked once robustly
+        self.n_factorisations += self.kkt.robust and not robust
         if state.rank_one:
             V = np.stack([v for _, v in state.rank_one], axis=1)             # (n, k)
             c = np.array([c for c, _ in state.rank_one])
