@@ -52,7 +52,8 @@ _INTEGER_KEYS = {"nx", "ny", "n", "n_theta", "n_z", "n_rings", "subdivisions", "
 #: [solver] keys and their kinds ("length" values are converted from the file's length unit)
 _SOLVER = {"backend": "str", "collocation": "int", "type": "str", "method": "str", "steps": "int",
            "max_load": "float", "targets": "list", "max_steps": "int", "max_iterations": "int", "tol": "float",
-           "min_step": "float", "desired_iterations": "int", "max_growth": "float", "line_search": "bool",
+           "min_step": "float", "desired_iterations": "int", "max_growth": "float", "max_step": "float",
+           "line_search": "bool",
            "max_probe_displacement": "length", "refine_critical": "int",
            "reuse_factorisation": "bool", "reuse_ratio": "float", "anderson": "int", "inertia_rtol": "float",
            "krylov": "int", "krylov_rtol": "float"}

@@ -60,6 +60,9 @@ class PathOptions:
     desired_iterations : the step adapts towards this many Newton iterations (8: most of them are
         cheap modified-Newton iterations on a reused tangent; 5 before, which kept steps from growing)
     max_growth : largest factor by which a step grows
+    max_step : largest load-factor increment of a load-controlled step (None: no cap; the step
+        grows after easy steps).  A path compared as a curve by interpolation between its points
+        (graspdef.bench, ``compare = "curve"``) is capped at max_load / steps
     line_search : energy back-tracking in load control
     max_probe_displacement : [m] the path also ends (completed) once a probe has moved this far
         (for paths whose load never reaches ``max_load``, e.g. past a pressure maximum)
@@ -95,6 +98,7 @@ class PathOptions:
     min_step: float = 1e-6
     desired_iterations: int = 8
     max_growth: float = 2.0
+    max_step: float | None = None
     line_search: bool = True
     max_probe_displacement: float | None = None
     refine_critical: int = 12
@@ -133,6 +137,8 @@ class PathOptions:
             raise ProblemError(f"reuse_ratio must lie in (0, 1), got {self.reuse_ratio!r}")
         if not self.max_growth > 1:
             raise ProblemError(f"max_growth must exceed 1, got {self.max_growth!r}")
+        if self.max_step is not None and not (0 < self.max_step <= abs(self.max_load) * (1 + 1e-12)):
+            raise ProblemError(f"max_step must lie in (0, |max_load|] (a load-factor increment), got {self.max_step!r}")
         if self.max_probe_displacement is not None and not self.max_probe_displacement > 0:
             raise ProblemError(f"max_probe_displacement must be positive [m], got {self.max_probe_displacement!r}")
         t = np.asarray(self.targets, float)
@@ -570,6 +576,8 @@ class PathSolver:
         opt = self.opt
         lam_end = opt.max_load
         dlam = lam_end / opt.steps
+        cap = abs(lam_end) if opt.max_step is None else opt.max_step
+        dlam = np.sign(dlam) * min(abs(dlam), cap)
         dmin = abs(lam_end) * opt.min_step
         stops = self._stop_points()
         lam = 0.0
@@ -622,6 +630,7 @@ class PathSolver:
             # shrink only on failure (above); grow after easy steps
             growth = np.clip(np.sqrt(opt.desired_iterations / max(its, 1)), 1.0, opt.max_growth)
             dlam = step * growth if abs(step) >= abs(dlam) * 0.999 else dlam
+            dlam = np.sign(dlam) * min(abs(dlam), cap)
         raise _Failed(f"the path needed more than max_steps={opt.max_steps} steps (reached load factor {lam:.6g})")
 
     def _arc_length(self, sol, u, lam=0.0, mode=None):

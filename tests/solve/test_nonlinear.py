@@ -272,6 +272,22 @@ def test_a_path_that_cannot_continue_keeps_its_converged_part():
     assert all(p.load_factor < 1.0 for p in part.path)
 
 
+def test_max_step_caps_the_load_steps_and_keeps_the_equilibrium():
+    """A cantilever (L = 4, t = 0.1, E = 1e5) bent by a tip force to a large rotation: the uncapped
+    path grows its steps after easy ones (some increments above 0.1), while max_step = 0.1 keeps
+    every load-factor increment at or below 0.1; both end at the same equilibrium (to 1e-7 of the
+    tip's displacement: the same state, reached in more steps)."""
+    pr = Problem(*_cantilever(), [EdgeSupport("clamped", lambda x: np.abs(x[:, 0]) < 1e-9)])
+    tip = pr.locate((4.0, 0.5, 0))
+    pr.loads.append(PointLoad(tip.face, tip.bary, (0, 0, 5.0)))
+    free = solve_nonlinear(pr, PathOptions(steps=20))
+    capped = solve_nonlinear(pr, PathOptions(steps=20, max_step=0.1))
+    inc = lambda sol: np.diff([p.load_factor for p in sol.path])  # noqa: E731
+    assert inc(free).max() > 0.1 + 1e-9, inc(free)
+    assert inc(capped).max() <= 0.1 * (1 + 1e-9) and len(capped.path) >= 11, inc(capped)
+    assert np.allclose(capped.u, free.u, rtol=0, atol=1e-7 * np.abs(free.u).max())
+
+
 def test_bad_inputs_are_refused():
     m = rectangle(1.0, 1.0, 4, 4)
     sh = Shell(m.vertices, m.faces, LinearElastic(1e6, 0.3), 0.01)
@@ -291,6 +307,10 @@ def test_bad_inputs_are_refused():
         PathOptions(inertia_rtol=0.1)
     with pytest.raises(ProblemError, match="reuse_ratio"):
         PathOptions(reuse_ratio=1.0)
+    with pytest.raises(ProblemError, match="max_step"):
+        PathOptions(max_step=0.0)
+    with pytest.raises(ProblemError, match="max_step"):
+        PathOptions(max_load=2.0, max_step=2.5)
     with pytest.raises(ProblemError, match="no load"):
         solve_nonlinear(Problem(sh, [], sup))
     with pytest.raises(ProblemError, match="absolute pressure"):
