@@ -96,11 +96,15 @@ class Equilibrium:
         self.m = self.C.shape[0]
         self.kkt = KKTSystem(self.C, backend)
         self._CCt = spla.splu((self.C @ self.C.T).tocsc()) if self.m else None
-        self.n_factorisations = 0
         self.n_hessians = 0           # order-2 evaluations
         self.n_krylov = 0             # GMRES iterations of inexact Newton steps (one back-substitution each)
         self.last_krylov = 0          # GMRES iterations of the last inexact step
         self.floor = 0.0              # round-off level of |grad Pi| at the latest Hessian [N]
+
+    @property
+    def n_factorisations(self) -> int:
+        """Tangent factorisations so far (the KKT system's count, robust retries included)."""
+        return self.kkt.n_factor
 
     def close(self) -> None:
         self.kkt.close()
@@ -165,11 +169,8 @@ class Equilibrium:
         """Factor the KKT matrix of the state's Hessian; returns the inertia excess (negative
         eigenvalues of H on the constraint null space; 0 = stable) or None (no inertia)."""
         self.kkt.factor(state.hessian)
-        self.n_factorisations += 1
         self._lowrank = None
-        robust = self.kkt.robust
         neg = self.kkt.negative_pivots(self.m)      # an unexpected inertia is checked once robustly
-        self.n_factorisations += self.kkt.robust and not robust
         if state.rank_one:
             V = np.stack([v for _, v in state.rank_one], axis=1)             # (n, k)
             c = np.array([c for c, _ in state.rank_one])

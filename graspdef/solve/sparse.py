@@ -171,6 +171,7 @@ class KKTSystem:
         self.seconds_solve = 0.0
         self.norm = 0.0                   # infinity norm of the last factorised KKT matrix
         self.n_back = 0                   # back-substitutions (each right-hand side counted)
+        self.n_factor = 0                 # numerical factorisations (robust retries included)
 
     def __enter__(self):
         return self
@@ -199,6 +200,7 @@ class KKTSystem:
             A, _ = kkt_matrix(self.K, self.C)
             try:
                 self._lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A")
+                self.n_factor += 1
             except RuntimeError as exc:
                 raise SupportError(f"the constrained stiffness is singular ({exc}): a mechanism is free") from exc
             self.n_negative = None
@@ -224,6 +226,7 @@ class KKTSystem:
             self._map = upper_map                       # kept once PARDISO has analysed it
         s.set_phase(22)                                 # numerical factorisation
         s._call_pardiso(U, z)
+        self.n_factor += 1
         self._U = U
         self.perturbed = int(s.get_iparm(14))
         self.n_negative = int(s.get_iparm(23))
@@ -313,13 +316,15 @@ class KKTSystem:
                 break
             sol, res, eta = new, new_res, new_eta
         self.seconds_solve += time.perf_counter() - t0
-        if not np.all(np.isfinite(sol)):
+        finite = bool(np.all(np.isfinite(sol)))
+        if finite:
+            rel = float(np.linalg.norm(res) / bn)
+            amp = self.norm * float(np.abs(sol).max()) / max(float(np.abs(rhs).max()), 1e-300)
+        if (not finite or rel > rtol and not (eta <= BACKWARD_TOL and amp <= MAX_AMPLIFICATION)) and self.retry_robust():
+            return self.solve(f, g_in, rtol=rtol, refinements=refinements)
+        if not finite:
             raise SolverError("the linear solve produced non-finite values (singular system)")
-        rel = float(np.linalg.norm(res) / bn)
-        amp = self.norm * float(np.abs(sol).max()) / max(float(np.abs(rhs).max()), 1e-300)
         if rel > rtol and not (eta <= BACKWARD_TOL and amp <= MAX_AMPLIFICATION):
-            if self.retry_robust():
-                return self.solve(f, g_in, rtol=rtol, refinements=refinements)
             raise SolverError(f"linear solve residual {rel:.2e} exceeds {rtol:.0e} and its backward error "
                               f"{eta:.1e} exceeds {BACKWARD_TOL:.0e} (singular or too ill-conditioned)")
         return sol[:n], s * sol[n:], rel

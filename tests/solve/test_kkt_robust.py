@@ -74,6 +74,30 @@ def test_a_failed_solve_is_redone_with_the_robust_settings(monkeypatch, seed):
     assert np.abs(lam - lam_ref).max() <= 1e-8 * np.abs(lam_ref).max()
 
 
+def test_a_non_finite_solve_is_redone_and_every_factorisation_counted(monkeypatch):
+    """A back-substitution that returns non-finite values (simulated once) is a failed check like a
+    large residual: the system refactors with the robust settings and solves (SuperLU's solution to
+    1e-10); ``n_factor`` counts both factorisations (the path's factorisation count reads it)."""
+    K, C, f = _saddle()
+    with S.KKTSystem(C, "superlu") as ref:
+        ref.factor(K)
+        u_ref, _, _ = ref.solve(f)
+    calls = []
+    orig = S.KKTSystem._back
+
+    def back(self, b):
+        calls.append(self.robust)
+        x = orig(self, b)
+        return np.full_like(x, np.nan) if not self.robust else x
+
+    monkeypatch.setattr(S.KKTSystem, "_back", back)
+    with S.KKTSystem(C, "pardiso") as kkt:
+        kkt.factor(K)
+        u, _, _ = kkt.solve(f)
+        assert kkt.robust and kkt.n_factor == 2 and calls[0] is False
+    assert np.abs(u - u_ref).max() <= 1e-10 * np.abs(u_ref).max()
+
+
 def test_a_regular_system_keeps_the_fast_settings():
     """The default settings on a regular system: no retry (the robust settings cost 16 % more per
     factorisation at 10k vertices), and the solution is SuperLU's to 1e-10."""
@@ -81,7 +105,7 @@ def test_a_regular_system_keeps_the_fast_settings():
     with S.KKTSystem(C, "pardiso") as kkt:
         kkt.factor(K)
         u, _, _ = kkt.solve(f)
-        assert not kkt.robust
+        assert not kkt.robust and kkt.n_factor == 1
     with S.KKTSystem(C, "superlu") as ref:
         ref.factor(K)
         u_ref, _, _ = ref.solve(f)
