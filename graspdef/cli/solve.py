@@ -51,8 +51,12 @@ def run(args: argparse.Namespace) -> int:
         progress(args, f"path: {len(sol.path) - 1} points, {sol.n_factorisations} factorisations, "
                        f"{sol.timings.get('total', 0.0):.1f} s")
         for cp in sol.critical_points:
+            jump = cp.get("jump")
             progress(args, f"{cp['kind']} at load factor {cp['load_factor']:.6g} "
-                           f"(negative eigenvalues {cp['instability_before']} -> {cp['instability_after']})")
+                           f"(negative eigenvalues {cp['instability_before']} -> {cp['instability_after']})"
+                           + ("" if jump is None else f"; the path jumped to the equilibrium at load factor "
+                              f"{jump['to_load_factor']:.6g}, the largest control point moving "
+                              f"{jump['largest_control_point_move'] / spec.length_scale:.4g} {unit}"))
     else:
         from ..solve.linear import solve_linear
 

@@ -63,7 +63,10 @@ from ..problem.terms import TermValue as PotentialTerms
 #: reuse_ratio 0.9 and inertia_rtol 1e-4, stop the pinned ball at 12.9 of 20.37 N); no inexact
 #: (GMRES) Newton steps either (``krylov`` 0): on these branch-sensitive paths the iterates, hence
 #: possibly the branch, would differ from those the contact tables were made with (not yet tried).
-CONTACT_PATH = {"desired_iterations": 8, "reuse_ratio": 0.5, "inertia_rtol": 0.0, "krylov": 0}
+#: A grasp that reaches a limit point of the finger force stops there (``limit_points`` "stop"):
+#: which state a gripper snaps to is a question for its dynamics, not for this quasi-static path.
+CONTACT_PATH = {"desired_iterations": 8, "reuse_ratio": 0.5, "inertia_rtol": 0.0, "krylov": 0,
+                "limit_points": "stop"}
 
 
 # ---------------------------------------------------------------------------------------------

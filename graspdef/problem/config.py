@@ -56,7 +56,8 @@ _SOLVER = {"backend": "str", "collocation": "int", "type": "str", "method": "str
            "line_search": "bool",
            "max_probe_displacement": "length", "refine_critical": "int",
            "reuse_factorisation": "bool", "reuse_ratio": "float", "anderson": "int", "inertia_rtol": "float",
-           "krylov": "int", "krylov_rtol": "float"}
+           "krylov": "int", "krylov_rtol": "float", "jump_ratio": "float", "limit_points": "str",
+           "bifurcation": "str"}
 _LENGTH_KEYS = {"lx", "ly", "center", "a", "b", "c", "radius", "length", "half_width", "scale", "r_inner", "r_outer",
                 "edge_length"}
 _REFERENCE = {"value", "quantity", "tolerance", "source", "formula", "load_factors", "values", "curve",

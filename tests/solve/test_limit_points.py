@@ -1,0 +1,132 @@
+"""Load control at a limit point of the load: the path snaps -- and says so -- or stops there.
+
+The shallow hinged cylindrical roof (benchmarks/nonlinear/hinged_roof.toml, Sze, Liu & Lo 2004,
+test 3.8, after Sabir & Lock 1972) under a central *force* P = P_max = 3000 (750 on the 1/4
+model), 8 x 8 cells: its equilibrium path has a limit point at P/P_max = 0.7437 (Sze's Abaqus
+S4R; this mesh by arc length, measured: 0.732830 at -W_C = 10.630, stability 0 -> 1, and the
+minimum 0.17538 at 19.38, 1 -> 0), falls to 0.173 after it and climbs again, reaching P_max at
+-W_C = 28.87 (Sze's table, linearly interpolated between 0.9643 at 28.66 and 1.0835 at 29.37).
+A load-controlled path cannot follow the falling part: at 16 x 16 the code before this check
+stepped from P/P_max 0.7185 (-W_C 9.08) straight to 0.9363 (-W_C 28.31), every point stable, no
+critical point recorded.
+"""
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from graspdef.errors import ProblemError
+from graspdef.problem.config import load_problem
+from graspdef.solve.nonlinear import PathOptions, path_options, solve_nonlinear
+
+NL = Path(__file__).resolve().parents[2] / "benchmarks" / "nonlinear"
+ARC_LIMIT, ARC_W = 0.732830, 10.630      # the same 8 x 8 roof by arc length (measured, see above)
+
+
+def _roof(tmp_path, **options):
+    text = (NL / "hinged_roof.toml").read_text()
+    text = text.replace("n_theta = 32", "n_theta = 8").replace("n_z = 32", "n_z = 8")
+    support = ('[[supports]]\nkind = "point"\nname = "C"\nat = [0.0, 2540.0, 0.0]\n'
+               'directions = [[0.0, 1.0, 0.0]]\ndisplacement = [-30.0]\n')
+    solver = '[solver]\ntype = "nonlinear"\nmethod = "load"\nsteps = 60\nmax_steps = 2000\n'
+    assert support in text and solver in text
+    text = text.replace(support, '[[loads]]\nkind = "point"\nat = [0.0, 2540.0, 0.0]\nforce = [0.0, -750.0, 0.0]\n')
+    text = text.replace(solver, '[solver]\ntype = "nonlinear"\nmethod = "load"\nsteps = 10\n')
+    path = tmp_path / "hinged_roof_force.toml"
+    path.write_text(text[:text.index("[reference]")])
+    spec = load_problem(path)
+    return solve_nonlinear(spec.problem, replace(path_options(spec.solver), **options), backend=spec.backend,
+                           allow_partial=True)
+
+
+def test_load_control_snaps_at_the_limit_point_and_records_it(tmp_path):
+    """The path approaches the limit point in ever smaller steps (the predicted increment may grow
+    by max_growth at most), brackets it to 2^-12 of the first step, and snaps at that load to the
+    stiffening branch, recording a limit point passed by a jump; then it goes on to P_max.
+    Measured: limit 0.732813 (-0.002 % from the arc length's 0.732830) at -W_C 10.585 (-0.4 %),
+    the snap to -W_C 27.0 at that load, and P_max at -W_C 28.7 (Sze 28.87).  ~8 s."""
+    sol = _roof(tmp_path)
+    assert sol.completed, sol.stop_reason
+    assert len(sol.critical_points) == 1, sol.critical_points
+    cp = sol.critical_points[0]
+    assert cp["kind"] == "limit point (jumped)"
+    assert abs(cp["load_factor"] - ARC_LIMIT) <= 1e-3 * ARC_LIMIT, cp
+    assert abs(cp["load_factor"] - 0.7437) <= 0.03 * 0.7437
+    assert abs(-cp["probes"]["C"][1] - ARC_W) <= 0.01 * ARC_W, cp        # the deflection at it
+    assert (cp["instability_before"], cp["instability_after"]) == (0, 0)
+    jump = cp["jump"]
+    assert jump["to_load_factor"] == cp["load_factor"]                  # the snap at constant load
+    landed = next(p for p in sol.path if p.load_factor == cp["load_factor"] and -p.probes["C"][1] > 19.85)
+    assert landed.stable                                               # past the minimum (19.85): stiffening branch
+    assert any(e["action"] == "jumped past a limit point" for e in sol.events)
+    end = sol.at(1.0)
+    assert end.stable and abs(-end.probes["C"][1] - 28.87) <= 0.03 * 28.87, end.probes
+
+
+def test_limit_points_stop_ends_the_path_at_the_limit_load(tmp_path):
+    """``limit_points = "stop"``: the same path ends at the limit point, not completed, saying
+    why; its last point is the limit load (to 0.1 %)."""
+    sol = _roof(tmp_path, limit_points="stop")
+    assert not sol.completed
+    assert "limit point" in sol.stop_reason, sol.stop_reason
+    assert abs(sol.load_factor - ARC_LIMIT) <= 1e-3 * ARC_LIMIT, sol.load_factor
+    assert not sol.critical_points
+
+
+@pytest.mark.parametrize("kw, msg", [
+    (dict(jump_ratio=-0.5), "jump_ratio must be a non-negative number"),
+    (dict(jump_ratio="big"), "jump_ratio must be a non-negative number"),
+    (dict(jump_ratio=float("nan")), "jump_ratio must be a non-negative number"),
+    (dict(limit_points="fly"), "limit_points must be one of jump, stop"),
+])
+def test_bad_limit_point_options_are_one_clear_line(kw, msg):
+    with pytest.raises(ProblemError, match=msg) as err:
+        PathOptions(**kw)
+    assert "\n" not in str(err.value)
+
+
+@pytest.mark.slow
+def test_pinched_cylinder_passes_its_small_limit_point_by_a_recorded_jump(tmp_path):
+    """The 48 x 48 1/8 pinched cylinder (benchmarks/nonlinear/pinched_cylinder_large.toml, load
+    point driven inwards) has a small limit point of its control at lambda = 0.96202 (-W_A =
+    86.58): followed by arc length (measured once, 2026-11-26), the path turns back to a second
+    limit point at 0.90136 and forward again, reaching lambda = 1 at U_B = 41.58925.  Load
+    control without a step cap used to stop at it ("Newton diverges", 0.962018); with the cap of
+    the benchmark's curve comparison it used to jump over it unnoticed.  Now both record it as a
+    limit point passed by a jump and end on the arc-length path's state.  ~4 minutes."""
+    text = (NL / "pinched_cylinder_large.toml").read_text()
+    assert "n_theta = 32" in text and "n_z = 32" in text
+    p = tmp_path / "pinched_cylinder_large_48.toml"
+    p.write_text(text.replace("n_theta = 32", "n_theta = 48").replace("n_z = 32", "n_z = 48"))
+    spec = load_problem(p)
+    opts = path_options(spec.solver)
+    opts = replace(opts, targets=tuple(float(v) for v in spec.reference["load_factors"] if v < 1.0))
+    sol = solve_nonlinear(spec.problem, opts, backend=spec.backend, allow_partial=True)
+    assert sol.completed, sol.stop_reason
+    jumps = [cp for cp in sol.critical_points if cp["kind"] == "limit point (jumped)"]
+    assert len(jumps) == 1, sol.critical_points
+    assert abs(jumps[0]["load_factor"] - 0.96202) <= 1e-5, jumps[0]
+    assert abs(sol.at(1.0).probes["B"][1] - 41.58925) <= 1e-4 * 41.58925, sol.at(1.0).probes
+
+
+@pytest.mark.parametrize("line, msg", [
+    ('jump_ratio = "big"', "jump_ratio"),
+    ("jump_ratio = -1.0", "jump_ratio must be a non-negative number"),
+    ('limit_points = "fly"', "limit_points must be one of jump, stop"),
+    ('bifurcation = "maybe"', "bifurcation must be one of report, locate, switch"),
+])
+def test_limit_point_options_in_a_problem_file(tmp_path, line, msg):
+    """The [solver] keys reach the path options from a problem file (``bifurcation`` too, which
+    the README documented but the reader refused as an unknown key); a bad value is one line."""
+    text = (NL / "hinged_roof.toml").read_text()
+    solver = '[solver]\ntype = "nonlinear"\nmethod = "load"\nsteps = 60\nmax_steps = 2000\n'
+    assert solver in text
+    good = tmp_path / "good.toml"
+    good.write_text(text.replace(solver, solver + 'jump_ratio = 0.2\nlimit_points = "stop"\nbifurcation = "locate"\n'))
+    opts = path_options(load_problem(good).solver)
+    assert (opts.jump_ratio, opts.limit_points, opts.bifurcation) == (0.2, "stop", "locate")
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace(solver, solver + line + "\n"))
+    with pytest.raises(ProblemError, match=msg) as err:
+        path_options(load_problem(bad).solver)
+    assert "\n" not in str(err.value)
