@@ -103,7 +103,7 @@ class PathOptions:
         a jump it is O(1).  Measured: 0.0007-0.12 on resolved steps (a hinged roof, the 48 x 48
         pinched cylinder, the ball's grasps), up to 0.22 on steps ending next to a limit point;
         0.58 and 0.92 on steps that jumped over one unnoticed.  Not applied to the first step
-        (or after a failed one); 0: no check
+        nor to the first after a jump (no curvature term to go with them); 0: no check
     limit_points : what load control does where its steps stall (halved below ``min_step``) at
         a limit point of the load -- "jump" (the default): snap, as the loaded structure does,
         to the equilibrium that the smallest jumping step reached (or, if every attempt failed,
