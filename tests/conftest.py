@@ -135,3 +135,35 @@ def ranking_writer():
     """write_synthetic_ranking, for tests that need a variant (the per-folder conftest modules share
     the name 'conftest', so tests take it as a fixture instead of importing it)."""
     return write_synthetic_ranking
+
+
+# ------------------------------------------------------------------------------------------------
+# The hinged cylindrical roof (benchmarks/nonlinear/hinged_roof.toml) under a central *force*
+# instead of its prescribed centre deflection, at a given mesh and [solver] table: shared by the
+# arc-length benchmark test and the load-control limit-point tests.
+# ------------------------------------------------------------------------------------------------
+ROOF_FORCE_1_4 = 750.0              # P_max = 3000 on the whole roof, a quarter on the 1/4 model
+
+
+@pytest.fixture(scope="session")
+def roof_under_force():
+    """write(path, cells, solver_table) -> path of the roof's problem file with the central force
+    P_max (750 on the 1/4 model), ``cells`` x ``cells`` cells and the given [solver] table text."""
+    from pathlib import Path
+
+    src = Path(__file__).resolve().parents[1] / "benchmarks" / "nonlinear" / "hinged_roof.toml"
+
+    def write(path: Path, cells: int, solver: str) -> Path:
+        text = src.read_text()
+        assert "n_theta = 32" in text and "n_z = 32" in text
+        text = text.replace("n_theta = 32", f"n_theta = {cells}").replace("n_z = 32", f"n_z = {cells}")
+        support = ('[[supports]]\nkind = "point"\nname = "C"\nat = [0.0, 2540.0, 0.0]\n'
+                   'directions = [[0.0, 1.0, 0.0]]\ndisplacement = [-30.0]\n')
+        old = '[solver]\ntype = "nonlinear"\nmethod = "load"\nsteps = 60\nmax_steps = 2000\n'
+        assert support in text and old in text
+        text = text.replace(support, '[[loads]]\nkind = "point"\nat = [0.0, 2540.0, 0.0]\n'
+                                     f'force = [0.0, -{ROOF_FORCE_1_4}, 0.0]\n')
+        path.write_text(text.replace(old, solver))
+        return path
+
+    return write

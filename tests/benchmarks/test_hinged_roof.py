@@ -83,7 +83,7 @@ def test_hinged_roof_coarse_limit_point(tmp_path):
     assert worst <= 0.03, worst
 
 
-def test_hinged_roof_arc_length_finds_both_limit_points(tmp_path):
+def test_hinged_roof_arc_length_finds_both_limit_points(tmp_path, roof_under_force):
     """The same 16 x 16 roof under the central force P = P_max (750 on the 1/4 model) by arc
     length: the path's critical points are the limit load (stability 0 -> 1) and the minimum
     after the snap (1 -> 0), where displacement control found them.  Measured: 0.73939 at
@@ -92,17 +92,9 @@ def test_hinged_roof_arc_length_finds_both_limit_points(tmp_path):
     from graspdef.problem.config import load_problem
     from graspdef.solve.nonlinear import path_options, solve_nonlinear
 
-    text = (NL / "hinged_roof.toml").read_text()
-    text = text.replace("n_theta = 32", "n_theta = 16").replace("n_z = 32", "n_z = 16")
-    support = ('[[supports]]\nkind = "point"\nname = "C"\nat = [0.0, 2540.0, 0.0]\n'
-               'directions = [[0.0, 1.0, 0.0]]\ndisplacement = [-30.0]\n')
-    solver = '[solver]\ntype = "nonlinear"\nmethod = "load"\nsteps = 60\nmax_steps = 2000\n'
-    assert support in text and solver in text
-    text = text.replace(support, '[[loads]]\nkind = "point"\nat = [0.0, 2540.0, 0.0]\nforce = [0.0, -750.0, 0.0]\n')
-    text = text.replace(solver, '[solver]\ntype = "nonlinear"\nmethod = "arc_length"\nsteps = 40\n'
-                                'max_steps = 400\nmax_probe_displacement = 30.0\n')
-    path = tmp_path / "hinged_roof_arc.toml"
-    path.write_text(text)
+    path = roof_under_force(tmp_path / "hinged_roof_arc.toml", 16,
+                            '[solver]\ntype = "nonlinear"\nmethod = "arc_length"\nsteps = 40\n'
+                            'max_steps = 400\nmax_probe_displacement = 30.0\n')
     spec = load_problem(path)
     sol = solve_nonlinear(spec.problem, path_options(spec.solver), backend=spec.backend)
     limits = [cp for cp in sol.critical_points if cp["kind"] == "limit point"]

@@ -23,29 +23,21 @@ NL = Path(__file__).resolve().parents[2] / "benchmarks" / "nonlinear"
 ARC_LIMIT, ARC_W = 0.732830, 10.630      # the same 8 x 8 roof by arc length (measured, see above)
 
 
-def _roof(tmp_path, **options):
-    text = (NL / "hinged_roof.toml").read_text()
-    text = text.replace("n_theta = 32", "n_theta = 8").replace("n_z = 32", "n_z = 8")
-    support = ('[[supports]]\nkind = "point"\nname = "C"\nat = [0.0, 2540.0, 0.0]\n'
-               'directions = [[0.0, 1.0, 0.0]]\ndisplacement = [-30.0]\n')
-    solver = '[solver]\ntype = "nonlinear"\nmethod = "load"\nsteps = 60\nmax_steps = 2000\n'
-    assert support in text and solver in text
-    text = text.replace(support, '[[loads]]\nkind = "point"\nat = [0.0, 2540.0, 0.0]\nforce = [0.0, -750.0, 0.0]\n')
-    text = text.replace(solver, '[solver]\ntype = "nonlinear"\nmethod = "load"\nsteps = 10\n')
-    path = tmp_path / "hinged_roof_force.toml"
-    path.write_text(text[:text.index("[reference]")])
+def _roof(write, tmp_path, **options):
+    path = write(tmp_path / "hinged_roof_force.toml", 8, '[solver]\ntype = "nonlinear"\nmethod = "load"\nsteps = 10\n')
+    path.write_text(path.read_text().split("[reference]")[0])
     spec = load_problem(path)
     return solve_nonlinear(spec.problem, replace(path_options(spec.solver), **options), backend=spec.backend,
                            allow_partial=True)
 
 
-def test_load_control_snaps_at_the_limit_point_and_records_it(tmp_path):
+def test_load_control_snaps_at_the_limit_point_and_records_it(tmp_path, roof_under_force):
     """The path approaches the limit point in ever smaller steps (the predicted increment may grow
     by max_growth at most), brackets it to 2^-12 of the first step, and snaps at that load to the
     stiffening branch, recording a limit point passed by a jump; then it goes on to P_max.
     Measured: limit 0.732813 (-0.002 % from the arc length's 0.732830) at -W_C 10.585 (-0.4 %),
     the snap to -W_C 27.0 at that load, and P_max at -W_C 28.7 (Sze 28.87).  ~8 s."""
-    sol = _roof(tmp_path)
+    sol = _roof(roof_under_force, tmp_path)
     assert sol.completed, sol.stop_reason
     assert len(sol.critical_points) == 1, sol.critical_points
     cp = sol.critical_points[0]
@@ -63,10 +55,10 @@ def test_load_control_snaps_at_the_limit_point_and_records_it(tmp_path):
     assert end.stable and abs(-end.probes["C"][1] - 28.87) <= 0.03 * 28.87, end.probes
 
 
-def test_limit_points_stop_ends_the_path_at_the_limit_load(tmp_path):
+def test_limit_points_stop_ends_the_path_at_the_limit_load(tmp_path, roof_under_force):
     """``limit_points = "stop"``: the same path ends at the limit point, not completed, saying
     why; its last point is the limit load (to 0.1 %)."""
-    sol = _roof(tmp_path, limit_points="stop")
+    sol = _roof(roof_under_force, tmp_path, limit_points="stop")
     assert not sol.completed
     assert "limit point" in sol.stop_reason, sol.stop_reason
     assert abs(sol.load_factor - ARC_LIMIT) <= 1e-3 * ARC_LIMIT, sol.load_factor
