@@ -663,7 +663,8 @@ class PathSolver:
                 ratio = None
                 if curved and t_new is not None:
                     du = u_new - u
-                    ratio = float(np.linalg.norm(du - 0.5 * step * (t + t_new))) / max(float(np.linalg.norm(du)), 1e-300)
+                    mismatch = du - 0.5 * step * (t + t_new)          # trapezoid rule of the end tangents
+                    ratio = float(np.linalg.norm(mismatch)) / max(float(np.linalg.norm(du)), 1e-300)
                 if ratio is not None and opt.jump_ratio and ratio > opt.jump_ratio:
                     jumped = (u_new, lam_new, st, its, inst, ratio)
                     raise _Failed(f"the step jumped: its increment differs from the trapezoid rule of the tangents at "
@@ -678,11 +679,13 @@ class PathSolver:
                                        "action": "load step halved", "reason": str(exc)})
                     dlam = step / 2
                     continue
-                stalled = (f"load step cut below {max(dmin, near) if limit else dmin:.3g} at load factor {lam:.6g}"
-                           f"{' (a limit point of the load: the response softened towards it)' if limit else ''}: {exc}")
+                why = " (a limit point of the load: the response softened towards it)" if limit else ""
+                floor = max(dmin, near) if limit else dmin
+                stalled = f"load step cut below {floor:.3g} at load factor {lam:.6g}{why}: {exc}"
                 if opt.limit_points != "jump" or back is None or not limit:
                     raise _Failed(stalled) from None
-                snapped = self._past(jumped, u, lam, nxt) or self._snap(u, lam, min(abs(dlam0), abs(nxt - lam)) * np.sign(lam_end))
+                first = min(abs(dlam0), abs(nxt - lam)) * np.sign(lam_end)
+                snapped = self._past(jumped, u, lam, nxt) or self._snap(u, lam, first)
                 if snapped is None:
                     raise _Failed(f"{stalled}; no equilibrium found past it either") from None
                 u_new, lam_new, st, its, inst, ratio = snapped
@@ -723,8 +726,8 @@ class PathSolver:
         raise _Failed(f"the path needed more than max_steps={opt.max_steps} steps (reached load factor {lam:.6g})")
 
     def _past(self, jumped, u, lam, nxt):
-        """Past the limit point at the converged (u, lam): the equilibrium of a rejected jumping step, brought
-        back to the limit point's own load (the snap happens at constant load; Newton from it),
+        """Past the limit point at the converged (u, lam): the equilibrium of a rejected jumping
+        step, brought back to the limit point's own load (the snap happens at constant load; Newton from it),
         else landed on the next stop point ``nxt`` if it lies beyond it, else as it is; None if
         there is none.  A landing that went back to u's branch does not count."""
         if jumped is None:
