@@ -1,6 +1,6 @@
 # graspdef: two commands on a fresh Debian/Ubuntu machine.
 #   make demo   set up (.venv, package, dependencies) and run the main job
-#   make test   set up, then run the test suite (tests marked `slow` are excluded)
+#   make test   set up, then run the test suite (tests marked `slow` are excluded), one worker per core
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -41,11 +41,15 @@ demo: setup
 	$(VENV)/bin/graspdef report out/demo_tennis_ball
 	@echo "look at it: out/demo_tennis_ball/report.html, or $(VENV)/bin/graspdef view out/demo_tennis_ball"
 
+# pytest-xdist: one worker per core (at most 4), a test file's tests on one worker (their
+# module-scoped fixtures are built once); every test must pass alone, in any file order
+XDIST  := -n auto --maxprocesses 4 --dist loadfile
+
 test: setup
-	$(PY) -m pytest -q -m "not slow"
+	$(PY) -m pytest -q -m "not slow" $(XDIST)
 
 test-slow: setup
-	$(PY) -m pytest -q -m slow
+	$(PY) -m pytest -q -m slow $(XDIST)
 
 clean:
 	rm -rf $(VENV) out .pytest_cache
