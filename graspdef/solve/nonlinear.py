@@ -345,7 +345,8 @@ class PathSolver:
         self.residual = (rn / scale, self.floor / scale)
         return ok, rn / scale
 
-    def newton(self, u0: np.ndarray, lam: float, factored: bool = False, patient: bool = False):
+    def newton(self, u0: np.ndarray, lam: float, factored: bool = False, patient: bool = False,
+               budget: int | None = None):
         """Equilibrium at fixed load factor from u0; returns (u, state, iterations, instability).
 
         Modified Newton with Anderson acceleration: a factorised tangent is reused (a gradient
@@ -365,7 +366,9 @@ class PathSolver:
         that factorisation finishes the iterations, gives the stability and is the next step's
         predictor and tangent.  With ``inertia_rtol = 0`` the converged state itself is always
         factorised (one more factorisation per point).  ``patient``: four times ``max_iterations``
-        and no divergence test (the energy descent from a point past a limit point).
+        and no divergence test (the energy descent from a point past a limit point).  ``budget``:
+        at most this many iterations instead of ``max_iterations`` (the attempts that bracket a
+        limit point).
 
         Inexact Newton (``krylov`` > 0): where the reused tangent contracts poorly (or its step
         raises the energy) above ``inertia_rtol``, the Newton system at the iterate is solved by
@@ -418,7 +421,7 @@ class PathSolver:
             inexact, hist = False, []
             return st, eq.solve(-st.gradient, cres), True
 
-        max_it = 4 * opt.max_iterations if patient else opt.max_iterations
+        max_it = 4 * opt.max_iterations if patient else opt.max_iterations if budget is None else budget
         for it in range(max_it + 1):
             st = eq.evaluate(u, lam, 2 if need_h else 1)
             if not np.isfinite(st.energy) or not np.all(np.isfinite(st.gradient)):
@@ -653,7 +656,11 @@ class PathSolver:
                 u0, factored = u.copy(), False
             snapped = None
             try:
-                u_new, st, its, inst = self.newton(u0, lam_new, factored=factored)
+                # bracketing a limit point that a step jumped over: an attempt beyond it has no
+                # equilibrium to converge to, and one short of it converges in a few iterations
+                # (the predictor is close): desired_iterations of them decide
+                budget = min(opt.desired_iterations, opt.max_iterations) if jumped is not None else None
+                u_new, st, its, inst = self.newton(u0, lam_new, factored=factored, budget=budget)
                 # the tangent du/dlam at the new point (its factorisation is at hand: the next
                 # step's predictor), and the step's consistency with the two tangents
                 try:
