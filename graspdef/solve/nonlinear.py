@@ -7,7 +7,10 @@
   towards a limit point), and a step whose increment differs from the trapezoid rule of the
   tangents du/dlam at its two ends by more than ``jump_ratio`` of itself is rejected and
   halved: it jumped -- over a limit point, or onto another branch -- which the stability of the
-  points alone does not show (both ends may be stable).  Where the halved
+  points alone does not show (both ends may be stable).  Once a limit point is suspected, each
+  step aims 0.9 of the way to its load as extrapolated from the tangents (|du/dlam|^-2 falls
+  linearly to zero there: :func:`fold_estimate`), and the attempts beyond it get
+  ``desired_iterations`` Newton iterations.  Where the halved
   steps stall (cut below ``min_step``) at such a limit point of the load, the path snaps as a
   loaded structure does (``limit_points = "jump"``): it takes the equilibrium past the limit
   point, records the limit point as passed by a jump (``critical_points``) and goes on; or it
@@ -54,6 +57,20 @@ class PathStopped(SolverError):
     def __init__(self, message: str, solution: "NonlinearSolution"):
         super().__init__(message)
         self.solution = solution
+
+
+#: a step that approaches a limit point aims this fraction of the way to its estimated load
+FOLD_SHORT = 0.9
+
+
+def fold_estimate(lam1: float, n1: float, lam2: float, n2: float) -> float | None:
+    """The load factor of a limit point ahead, from the tangent norms n = |du/dlam| at two
+    converged points approaching it: near a (quadratic) fold lam_c - lam ~ (u - u_c)^2, so
+    |du/dlam|^-2 falls linearly to zero at lam_c; None unless the tangent grows towards lam2."""
+    if not (n1 > 0 and n2 > n1 and lam2 != lam1):
+        return None
+    y1, y2 = n1 ** -2, n2 ** -2
+    return lam2 + y2 * (lam2 - lam1) / (y1 - y2)
 
 
 @dataclass(frozen=True)
@@ -627,8 +644,12 @@ class PathSolver:
         softening = False               # increments limited since the last plain step (a limit point ahead?)
         plain = True                    # no failure and no limited increment since the last point
         t_new = None                    # the tangent du/dlam at the current point, when solved
+        t_last = None                   # (load factor, |du/dlam|) at the previous converged point
         near = abs(dlam0) * 2.0 ** -opt.refine_critical   # a limit point's bracket is narrow enough
+        sgn = float(np.sign(lam_end))
         while len(sol.path) <= opt.max_steps:
+            t_here = None                                     # |du/dlam| at the current point
+            lc = None                                         # the load of a limit point ahead, estimated
             nxt = next(s for s in stops if (s - lam) * np.sign(lam_end) > 1e-12 * abs(lam_end))
             step = dlam if abs(dlam) < abs(nxt - lam) * (1 + 1e-9) else nxt - lam
             if abs(nxt - lam - step) < 1e-9 * abs(lam_end):
@@ -640,6 +661,7 @@ class PathSolver:
                 t = t_new if factored and t_new is not None else (
                     self.eq.solve(q, self.eq.g) if factored else self._tangent(u, lam))
                 factored = True
+                t_here = float(np.linalg.norm(t))
                 u0 = u + step * t
                 if back is not None:                          # + the curvature of the last step
                     h = lam - back[1]
@@ -652,14 +674,24 @@ class PathSolver:
                         step *= opt.max_growth * last / pred
                         lam_new, dlam, softening, capped = lam + step, step, True, True
                         u0 = u + step * t + (step / h) ** 2 * (back[0] - u + h * t)
+                    # a limit point ahead: aim the step short of the load where the tangents say
+                    # it is (FOLD_SHORT of the way there), not at the halving's guess
+                    lc = fold_estimate(*t_last, lam, t_here) if (softening or jumped is not None) and t_last else None
+                    if lc is not None and 0 < (lc - lam) * sgn < abs(step):
+                        aim = sgn * max(FOLD_SHORT * abs(lc - lam), 2 * near)
+                        if abs(aim) < abs(step):
+                            step, lam_new, dlam = aim, lam + aim, aim
+                            u0 = u + step * t + (step / h) ** 2 * (back[0] - u + h * t)
             except SolverError:
                 u0, factored = u.copy(), False
             snapped = None
             try:
-                # bracketing a limit point that a step jumped over: an attempt beyond it has no
-                # equilibrium to converge to, and one short of it converges in a few iterations
-                # (the predictor is close): desired_iterations of them decide
-                budget = min(opt.desired_iterations, opt.max_iterations) if jumped is not None else None
+                # bracketing a limit point that a step jumped over, or an attempt beyond its
+                # estimated load: an attempt beyond it has no equilibrium to converge to, and one
+                # short of it converges in a few iterations (the predictor is close):
+                # desired_iterations of them decide
+                beyond = jumped is not None or (lc is not None and (lam_new - lc) * sgn > 0)
+                budget = min(opt.desired_iterations, opt.max_iterations) if beyond else None
                 u_new, st, its, inst = self.newton(u0, lam_new, factored=factored, budget=budget)
                 # the tangent du/dlam at the new point (its factorisation is at hand: the next
                 # step's predictor), and the step's consistency with the two tangents
@@ -718,6 +750,7 @@ class PathSolver:
             self.eq.commit(u_new)
             self._emit(sol, pt)
             back = (u, lam) if snapped is None else None      # no curvature across a jump
+            t_last = (lam, t_here) if snapped is None and t_here is not None else None
             u, lam, q, factored = u_new, lam_new, st.load, snapped is None
             if snapped is not None:
                 t_new = None                                  # its factorisation may be elsewhere
@@ -753,16 +786,17 @@ class PathSolver:
     def _snap(self, u, lam, step):
         """An equilibrium past a limit point at the converged (u, lam) when no jumping step was
         found: Newton from u itself (the tangent is singular there) at lam + step, step / 2,
-        step / 4, patiently (the energy descends to the next stable state); (u, lam, state,
-        iterations, instability, None) or None."""
+        step / 4, patiently (the energy descends to the next stable state), then brought back to
+        lam by :meth:`_past` where that does not fall back; (u, lam, state, iterations,
+        instability, None) or None."""
         for h in (step, step / 2, step / 4):
             try:
                 u_new, st, its, inst = self.newton(u.copy(), lam + h, patient=True)
             except (_Failed, SolverError) as exc:
                 log.info("no equilibrium at load factor %.6g past the limit point (%s)", lam + h, exc)
                 continue
-            if inst in (0, None):
-                return u_new, lam + h, st, its, inst, None
+            if inst in (0, None):           # brought back to the limit point's load if it can
+                return self._past((u_new, lam + h, st, its, inst, None), u, lam, lam + h)
         return None
 
     def _record_jump(self, sol, u, lam, snapped, why):
