@@ -650,7 +650,7 @@ class PathSolver:
         while len(sol.path) <= opt.max_steps:
             t_here = None                                     # |du/dlam| at the current point
             lc = None                                         # the load of a limit point ahead, estimated
-            nxt = next(s for s in stops if (s - lam) * np.sign(lam_end) > 1e-12 * abs(lam_end))
+            nxt = next(s for s in stops if (s - lam) * sgn > 1e-12 * abs(lam_end))
             step = dlam if abs(dlam) < abs(nxt - lam) * (1 + 1e-9) else nxt - lam
             if abs(nxt - lam - step) < 1e-9 * abs(lam_end):
                 step = nxt - lam
@@ -723,14 +723,14 @@ class PathSolver:
                 stalled = f"load step cut below {floor:.3g} at load factor {lam:.6g}{why}: {exc}"
                 if opt.limit_points != "jump" or back is None or not limit:
                     raise _Failed(stalled) from None
-                first = min(abs(dlam0), abs(nxt - lam)) * np.sign(lam_end)
+                first = min(abs(dlam0), abs(nxt - lam)) * sgn
                 snapped = self._past(jumped, u, lam, nxt) or self._snap(u, lam, first)
                 if snapped is None:
                     raise _Failed(f"{stalled}; no equilibrium found past it either") from None
                 u_new, lam_new, st, its, inst, ratio = snapped
                 self._record_jump(sol, u, lam, snapped, stalled)
                 step = lam_new - lam
-            if jumped is not None and (jumped[1] - lam_new) * np.sign(lam_end) <= 0:
+            if jumped is not None and (jumped[1] - lam_new) * sgn <= 0:
                 jumped = None                                 # keep a jumped equilibrium still ahead
             if snapped is not None or (plain and not capped):
                 softening = False                             # a plain step: nothing ahead
