@@ -200,8 +200,13 @@ def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda
     ref = spec.reference
     opts = path_options(spec.solver)
     lfs = [float(v) for v in ref.get("load_factors", [])]
-    if lfs:
-        opts = replace(opts, targets=tuple(sorted(set(opts.targets) | set(lfs) - {opts.max_load})))
+    context = _context(path, ref)
+    if ref.get("compare") != "curve":
+        # the tabulated load factors are path targets; a curve's levels are values of its
+        # abscissa (e.g. P/P_max from a reaction), not load factors, and are interpolated instead
+        extra = set(lfs) | set(context["load_factors"] if context else ())
+        if extra:
+            opts = replace(opts, targets=tuple(sorted(set(opts.targets) | extra - {opts.max_load})))
     if ref.get("compare") == "curve" and opts.max_step is None:
         # a curve is compared by linear interpolation between path points (_curve_records): the
         # path is sampled at the file's step at least (grown steps left the pull-out's points 0.05
@@ -220,18 +225,60 @@ def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda
         if len(vals) != len(lfs):
             raise ProblemError(f"{path}: [reference.values] {expr} has {len(vals)} values for {len(lfs)} load factors")
 
-    def record(name, reference, value, rel):
-        records.append({"name": f"{spec.name} {name}", "reference": float(reference), "value": float(value),
-                        "rel_error": float(rel), "tolerance": tol, "passed": bool(tol is None or abs(rel) <= tol),
-                        "n_control": n_control, "seconds": seconds, "source": ref.get("source", ""),
-                        "units": spec.length_unit})
+    def recorder(prefix, tolerance, source):
+        def record(name, reference, value, rel):
+            records.append({"name": f"{spec.name} {prefix}{name}", "reference": float(reference), "value": float(value),
+                            "rel_error": float(rel), "tolerance": tolerance,
+                            "passed": bool(tolerance is None or abs(rel) <= tolerance),
+                            "n_control": n_control, "seconds": seconds, "source": source, "units": spec.length_unit})
+        return record
 
+    record = recorder("", tol, ref.get("source", ""))
     if "limit_point" in ref:
         _limit_point_records(spec, sol, ref, record)
-    if ref.get("compare", "each") == "curve":
+    _compare(spec, sol, ref, lfs, values, record)
+    if context:
+        # a second reference, reported beside the first and never judged (tolerance: report only)
+        _compare(spec, sol, ref, context["load_factors"], context["values"],
+                 recorder("context: ", None, context["source"]))
+    return records
+
+
+def _context(path, ref) -> dict | None:
+    """``[reference.context]``: another published curve of the same quantities (``source``,
+    ``load_factors``, ``values``), compared the same way and reported only -- e.g. a
+    shear-deformable element's curve beside the Kirchhoff-Love reference that is judged."""
+    ctx = ref.get("context")
+    if ctx is None:
+        return None
+    where = f"{path}: [reference.context]"
+    if not isinstance(ctx, dict):
+        raise ProblemError(f"{where} must be a table with source, load_factors and values")
+    unknown = set(ctx) - {"source", "load_factors", "values"}
+    if unknown:
+        raise ProblemError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} (expected source, load_factors, values)")
+    missing = {"source", "load_factors", "values"} - set(ctx)
+    if missing:
+        raise ProblemError(f"{where}: missing {', '.join(sorted(missing))}")
+    lfs = [float(v) for v in ctx["load_factors"]]
+    values = dict(ctx["values"])
+    unknown_q = set(values) - set(ref.get("values", {}))
+    if unknown_q:
+        raise ProblemError(f"{where}: values {', '.join(sorted(unknown_q))} are not among [reference.values]")
+    for expr, vals in values.items():
+        if len(vals) != len(lfs):
+            raise ProblemError(f"{where}: values {expr} has {len(vals)} values for {len(lfs)} load factors")
+    return {"source": str(ctx["source"]), "load_factors": lfs,
+            "values": {k: [float(v) for v in vals] for k, vals in values.items()}}
+
+
+def _compare(spec, sol, ref, lfs, values, record):
+    """One record per tabulated load factor and quantity, in the file's ``compare`` mode."""
+    mode = ref.get("compare", "each")
+    if mode == "curve":
         _curve_records(spec, sol, ref, lfs, values, record)
-        return records
-    if ref.get("compare", "each") == "vector":
+        return
+    if mode == "vector":
         # the quantities are the components of one vector (e.g. the tip position): error norm
         # relative to the reference vector's norm, per load factor
         for k, lf in enumerate(lfs):
@@ -240,14 +287,13 @@ def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda
             v = np.array([_point_quantity(spec, sol, pt, expr) for expr in values])
             record(f"|{', '.join(values)}| @ {lf:g}", np.linalg.norm(r), np.linalg.norm(v),
                    np.linalg.norm(v - r) / np.linalg.norm(r))
-        return records
+        return
     rn = set(ref.get("range_normalised", []))
     for expr, vals in values.items():
         denom = max(abs(x) for x in vals) if expr in rn else None
         for lf, reference in zip(lfs, vals):
             value = _path_quantity(spec, sol, sol.at(lf), expr, ref)
             record(f"{expr} @ {lf:g}", reference, value, (value - reference) / (denom or abs(reference)))
-    return records
 
 
 def _path_quantity(spec, sol, point, expr: str, ref) -> float:
@@ -326,7 +372,8 @@ def run_nonlinear_benchmarks(folder: Path, pattern: str = "*",
     for f in benchmark_files(folder, pattern):
         progress(f"benchmark {f.stem} ...")
         rs = run_nonlinear_benchmark(f, progress)
-        worst = max(rs, key=lambda r: abs(r["rel_error"]) if np.isfinite(r["rel_error"]) else np.inf)
+        judged = [r for r in rs if r["tolerance"] is not None] or rs      # context records are reported only
+        worst = max(judged, key=lambda r: abs(r["rel_error"]) if np.isfinite(r["rel_error"]) else np.inf)
         progress(f"  {f.stem}: {len(rs)} compared points, worst {100 * worst['rel_error']:+.3f} % "
                  f"({worst['name']}), {worst['seconds']:.1f} s")
         records += rs

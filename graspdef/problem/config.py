@@ -62,7 +62,7 @@ _LENGTH_KEYS = {"lx", "ly", "center", "a", "b", "c", "radius", "length", "half_w
                 "edge_length"}
 _REFERENCE = {"value", "quantity", "tolerance", "source", "formula", "load_factors", "values", "curve",
               "curve_params", "compare", "abscissa", "abscissa_scale", "range_normalised",
-              "reaction_scale", "limit_point"}
+              "reaction_scale", "limit_point", "context"}
 _SUPPORT_KEYS = {"rigid_modes": ({"kind", "name"}, ()),
                  "point": ({"kind", "name", "at", "face", "bary", "directions", "tolerance", "displacement", "side"},
                            ())}

@@ -40,6 +40,51 @@ def test_cantilever_end_shear_matches_the_elastica():
     assert worst < 2e-3
 
 
+def test_a_context_reference_is_reported_beside_the_judged_one_and_never_judged(tmp_path):
+    """``[reference.context]`` (a second published curve, e.g. Sze's shear-deformable S4R beside
+    a Kirchhoff-Love reference): its records carry the context's source, "report only" (no
+    tolerance, never failed) and the error against *its* values, on the same path.  Invariant
+    checked: a context copy of the elastica scaled by 1.1 gives value/ref - 1 = (1 + e)/1.1 - 1
+    for the judged error e at every load; the judged records are those of the file alone."""
+    text = (BENCH / "cantilever_shear.toml").read_text()
+    head, vals = text.split("[reference.values]\n")
+    lfs = head.split("load_factors = ")[1].split("\n")[0]
+    rows = dict(line.split(" = ") for line in vals.strip().splitlines())
+    scaled = {k: "[" + ", ".join(f"{1.1 * float(x):.12g}" for x in v.strip("[]").split(", ")) + "]"
+              for k, v in rows.items()}
+    context = ('\n[reference.context]\nsource = "the elastica, scaled by 1.1"\nload_factors = ' + lfs
+               + "\n[reference.context.values]\n" + "".join(f"{k} = {v}\n" for k, v in scaled.items()))
+    f = tmp_path / "cantilever_context.toml"
+    f.write_text(text + context)
+    recs = run_nonlinear_benchmark(f)
+    judged = [r for r in recs if r["tolerance"] is not None]
+    ctx = [r for r in recs if r["tolerance"] is None]
+    assert len(judged) == len(ctx) == 40
+    _check(judged)
+    by_name = {r["name"].replace("context: ", ""): r for r in ctx}
+    for r in judged:
+        c = by_name[r["name"]]
+        assert c["passed"] and c["source"] == "the elastica, scaled by 1.1"
+        assert c["value"] == r["value"]
+        assert abs(c["rel_error"] - ((1 + r["rel_error"]) / 1.1 - 1)) < 1e-9, (r, c)
+
+
+@pytest.mark.parametrize("block, msg", [
+    ('[reference.context]\nsource = "x"\nload_factors = [1.0]\nvalues = 3\nfoo = 1\n', "unknown key.*foo"),
+    ('[reference.context]\nsource = "x"\nload_factors = [1.0]\n', "missing values"),
+    ('[reference.context]\nsource = "x"\nload_factors = [1.0]\n[reference.context.values]\n"probe.tip.y" = [1.0]\n',
+     "probe.tip.y are not among"),
+    ('[reference.context]\nsource = "x"\nload_factors = [0.5, 1.0]\n[reference.context.values]\n"probe.tip.z" = [1.0]\n',
+     "1 values for 2 load factors"),
+])
+def test_a_bad_context_reference_is_one_clear_line(tmp_path, block, msg):
+    f = tmp_path / "bad.toml"
+    f.write_text((BENCH / "cantilever_shear.toml").read_text() + "\n" + block)
+    with pytest.raises(ProblemError, match=msg) as err:
+        run_nonlinear_benchmark(f)
+    assert "\n" not in str(err.value) and "[reference.context]" in str(err.value)
+
+
 def test_cantilever_rolls_into_a_full_circle():
     """BENCHMARKS.md 3.2: follower end moment M = 2 pi EI / L rolls the strip into a circle; tip
     position within 1 % of the closed form at every tabulated load: |error| / |exact tip
