@@ -85,13 +85,22 @@ def test_nonlinear_leaves_linear_at_order_load(study):
 
 @pytest.mark.slow
 def test_pullout_benchmark_free_edge():
-    """benchmarks/nonlinear/pullout_cylinder.toml (24x16, 1/8 model): every tabulated point within the
-    file's tolerance of Sze's S4R table, and the free-edge point C within 1 % at P/P_max = 0.5 and 1
-    (measured -0.17 % and +0.47 %)."""
+    """benchmarks/nonlinear/pullout_cylinder.toml (24x16, 1/8 model) against nligaStruct's
+    Kirchhoff-Love isogeometric curve (SVK, 2860 bicubic elements, 21 tabulated loads, the snap
+    near P/P_max = 0.5 among them): every point within the file's 2 %, and the free-edge point C
+    within 0.5 % at every load (measured: worst of all points -0.28 %, of C -0.25 % at 0.4775;
+    C at P_max +0.03 %).  Sze's S4R table is the file's context, reported only: C within 1 % of
+    it at P/P_max = 0.5 and 1 (measured -0.1 % and +0.40 %; A at P_max -1.5 %, as nligaStruct's
+    own A is -1.3 % from S4R)."""
     from graspdef.bench import run_nonlinear_benchmark
 
     recs = run_nonlinear_benchmark(SCRIPT.parents[1] / "benchmarks" / "nonlinear" / "pullout_cylinder.toml")
-    assert all(r["passed"] for r in recs), [r["name"] for r in recs if not r["passed"]]
-    c = {r["name"].split(" @ ")[1]: r["rel_error"] for r in recs if "probe.C" in r["name"]}
+    judged = [r for r in recs if r["tolerance"] is not None]
+    assert len(judged) == 3 * 21 and all("nligaStruct" in r["source"] for r in judged)
+    assert all(r["passed"] for r in judged), [r["name"] for r in judged if not r["passed"]]
+    c_kl = [r["rel_error"] for r in judged if "probe.C" in r["name"]]
+    assert len(c_kl) == 21 and max(abs(e) for e in c_kl) < 0.005, c_kl
+    c = {r["name"].split(" @ ")[1]: r["rel_error"] for r in recs
+         if r["tolerance"] is None and "probe.C" in r["name"]}
     assert abs(c["0.5"]) < 0.01 and abs(c["1"]) < 0.01, c
     assert np.isfinite(list(c.values())).all()
