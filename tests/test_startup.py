@@ -182,3 +182,28 @@ def test_configure_fixes_openblas_threads_unless_the_user_did():
     assert run() == ["1", "1", True]
     assert run(extra={"OPENBLAS_NUM_THREADS": "2"}) == ["2", "2", True]
     assert run(pre="import numpy\n") == ["1", "1", False]
+
+
+def test_a_pardiso_solver_without_configure_does_not_search_for_mkl():
+    """A library user who never calls ``runtime.configure``: creating PARDISO solvers must not
+    make pypardiso search sys.prefix for MKL's runtime (a recursive glob, ~1 s per solver and
+    2-4 s on a loaded machine) -- ``graspdef.solve.sparse`` names the library once.  Counted in a
+    fresh interpreter with PYPARDISO_MKL_RT unset: pypardiso's recursive globs for ``mkl_rt``."""
+    code = ("import glob, json, os\n"
+            "calls = []\n_glob = glob.glob\n"
+            "def counting(pattern, *a, **k):\n"
+            "    if 'mkl_rt' in pattern: calls.append(pattern)\n"
+            "    return _glob(pattern, *a, **k)\n"
+            "glob.glob = counting\n"
+            "from graspdef.solve import sparse\n"
+            "ok = sparse.pardiso_available()\n"
+            "solvers = [sparse._new_pardiso(2) for _ in range(3)] if ok else []\n"
+            "print(json.dumps([ok, [c for c in calls if '**' in c], os.environ.get('PYPARDISO_MKL_RT')]))")
+    env = {k: v for k, v in os.environ.items() if k != "PYPARDISO_MKL_RT"}
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=ROOT, check=False)
+    assert r.returncode == 0, r.stderr
+    ok, recursive, named = json.loads(r.stdout.strip().splitlines()[-1])
+    if not ok:
+        pytest.skip("pypardiso not installed")
+    assert recursive == [], recursive
+    assert named and Path(named).is_file(), named
