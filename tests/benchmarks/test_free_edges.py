@@ -104,3 +104,30 @@ def test_pullout_benchmark_free_edge():
          if r["tolerance"] is None and "probe.C" in r["name"]}
     assert abs(c["0.5"]) < 0.01 and abs(c["1"]) < 0.01, c
     assert np.isfinite(list(c.values())).all()
+
+
+@pytest.mark.slow
+def test_pullout_in_neo_hookean_material_against_the_kirchhoff_love_iga_curve():
+    """benchmarks/nonlinear/pullout_cylinder_neo_hookean.toml: the same pull-out (24x16) in an
+    incompressible neo-Hookean material (mu = 4e6, three Gauss points through the thickness)
+    against nligaStruct's Kirchhoff-Love IGA in the same material (678 bicubic elements, 33 loads).
+    Measured: at P_max A / B / C within 0.14 % (2.6530 / 4.3609 / 3.4908 against 2.6508 /
+    4.3627 / 3.4955), and 97 of the 99 points within the file's 2 %.  The two others lie on the
+    steep branch of the snap (B at P/P_max = 0.718 and 0.732: +2.3 % and +4.0 %, and +3.0 % /
+    +4.3 % on 48x32, so not the mesh); there the two published curves disagree with each other
+    in turn -- Abaqus S4R in the same material (the file's context) has B 2.2 % *below* ours at
+    0.735.  The test holds what is settled: every point off that branch within 2 %, P_max within
+    0.5 %, and the branch's misses reported as misses (``passed`` False), not hidden."""
+    from graspdef.bench import run_nonlinear_benchmark
+
+    recs = run_nonlinear_benchmark(SCRIPT.parents[1] / "benchmarks" / "nonlinear" / "pullout_cylinder_neo_hookean.toml")
+    judged = [r for r in recs if r["tolerance"] is not None]
+    assert len(judged) == 3 * 33 and all("neo-Hookean" in r["source"] for r in judged)
+    level = lambda r: float(r["name"].split(" @ ")[1])
+    off_branch = [r for r in judged if not 0.715 < level(r) < 0.737]
+    assert len(off_branch) == 3 * 30
+    assert all(r["passed"] for r in off_branch), [(r["name"], r["rel_error"]) for r in off_branch if not r["passed"]]
+    at_max = [r for r in judged if level(r) == 1.0]
+    assert len(at_max) == 3 and all(abs(r["rel_error"]) < 0.005 for r in at_max), at_max
+    missed = sorted(r["name"].split(" ", 1)[1] for r in judged if not r["passed"])
+    assert all(0.715 < float(n.split(" @ ")[1]) < 0.737 for n in missed), missed
