@@ -189,29 +189,38 @@ def _balloon_records(spec, sol, ref, tol, n_control, seconds):
     return records
 
 
-def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda m: None) -> list[dict]:
-    """Solve one nonlinear benchmark file; one record per compared point of its path."""
+def benchmark_path_options(spec, context: dict | None = None):
+    """The path options a benchmark file is solved with: its [solver] options, plus its tabulated
+    load factors (and its context's) as path targets, or -- for a curve compared along a
+    displacement-controlled path -- a step of at most max_load / steps (the levels are abscissa
+    values, e.g. P/P_max, interpolated between path points, not load factors)."""
     from dataclasses import replace
 
-    from .solve.nonlinear import path_options, solve_nonlinear
+    from .solve.nonlinear import path_options
+
+    ref = spec.reference
+    opts = path_options(spec.solver)
+    if ref.get("compare") != "curve":
+        extra = {float(v) for v in ref.get("load_factors", [])} | set(context["load_factors"] if context else ())
+        if extra:
+            opts = replace(opts, targets=tuple(sorted(set(opts.targets) | extra - {opts.max_load})))
+    elif opts.max_step is None:
+        # grown steps left the pull-out's points 0.05 apart at its snap and the linear
+        # interpolation there 5.7 % off
+        opts = replace(opts, max_step=abs(opts.max_load) / opts.steps)
+    return opts
+
+
+def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda m: None) -> list[dict]:
+    """Solve one nonlinear benchmark file; one record per compared point of its path."""
+    from .solve.nonlinear import solve_nonlinear
 
     t0 = time.perf_counter()
     spec = load_problem(path)
     ref = spec.reference
-    opts = path_options(spec.solver)
     lfs = [float(v) for v in ref.get("load_factors", [])]
     context = _context(path, ref)
-    if ref.get("compare") != "curve":
-        # the tabulated load factors are path targets; a curve's levels are values of its
-        # abscissa (e.g. P/P_max from a reaction), not load factors, and are interpolated instead
-        extra = set(lfs) | set(context["load_factors"] if context else ())
-        if extra:
-            opts = replace(opts, targets=tuple(sorted(set(opts.targets) | extra - {opts.max_load})))
-    if ref.get("compare") == "curve" and opts.max_step is None:
-        # a curve is compared by linear interpolation between path points (_curve_records): the
-        # path is sampled at the file's step at least (grown steps left the pull-out's points 0.05
-        # apart at its snap and the interpolation there 5.7 % off)
-        opts = replace(opts, max_step=abs(opts.max_load) / opts.steps)
+    opts = benchmark_path_options(spec, context)
     sol = solve_nonlinear(spec.problem, opts, backend=spec.backend,
                           progress=lambda i: progress(f"    point {i['step']}: load factor {i['load_factor']:.4g}"))
     seconds = time.perf_counter() - t0

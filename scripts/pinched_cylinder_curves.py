@@ -16,7 +16,6 @@ import argparse
 import sys
 import tempfile
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -27,8 +26,8 @@ FILE = ROOT / "benchmarks" / "nonlinear" / "pinched_cylinder_large.toml"
 
 def solve_path(cells: int) -> dict:
     """The file's path on cells x cells (the bench's options); P/P_max, -W_A, U_B per point."""
-    from graspdef.bench import _abscissa, _point_quantity, load_problem
-    from graspdef.solve.nonlinear import path_options, solve_nonlinear
+    from graspdef.bench import _abscissa, _point_quantity, benchmark_path_options, load_problem
+    from graspdef.solve.nonlinear import solve_nonlinear
 
     text = FILE.read_text()
     assert "n_theta = 48" in text and "n_z = 48" in text
@@ -37,8 +36,7 @@ def solve_path(cells: int) -> dict:
         p.write_text(text.replace("n_theta = 48", f"n_theta = {cells}").replace("n_z = 48", f"n_z = {cells}"))
         spec = load_problem(p)
     ref = spec.reference
-    opts = path_options(spec.solver)
-    opts = replace(opts, max_step=abs(opts.max_load) / opts.steps)
+    opts = benchmark_path_options(spec)
     t0 = time.perf_counter()
     sol = solve_nonlinear(spec.problem, opts, backend=spec.backend)
     pts = [q for q in sol.path if q.kind != "refine"]
