@@ -29,6 +29,7 @@ from ..units import FORCE_UNITS  # noqa: F401  (re-exported: the unit tables liv
 from .edges import face_centroids
 from .loads import BodyForce, EdgeLoad, PointLoad, Pressure
 from .potentials import EdgeMoment, EnclosedGas, FollowerPressure
+from .nitsche import NITSCHE_GAMMA
 from .problem import BACKENDS, Problem, SurfacePoint, locate
 from .supports import KINDS, EdgeSupport, PointSupport, RigidModes
 
@@ -50,7 +51,7 @@ _GEOMETRY = {
 _GEOMETRY_OPTIONAL = {"center", "theta0_deg", "theta1_deg", "hole_angle_deg", "scale", "units", "slit_deg", "holes", "refinements"}
 _INTEGER_KEYS = {"nx", "ny", "n", "n_theta", "n_z", "n_rings", "subdivisions", "n_r", "refinements"}
 #: [solver] keys and their kinds ("length" values are converted from the file's length unit)
-_SOLVER = {"backend": "str", "collocation": "int", "type": "str", "method": "str", "steps": "int",
+_SOLVER = {"backend": "str", "collocation": "int", "nitsche_gamma": "float", "type": "str", "method": "str", "steps": "int",
            "max_load": "float", "targets": "list", "max_steps": "int", "max_iterations": "int", "tol": "float",
            "min_step": "float", "desired_iterations": "int", "max_growth": "float", "max_step": "float",
            "line_search": "bool",
@@ -231,11 +232,15 @@ def _material(mat: Table, units: FileUnits):
         raise ConfigError(f"{mat.where()} {exc}") from None
 
 
-def _solver(solver: Table, units: FileUnits) -> tuple[str, int, dict]:
-    """(backend, collocation points per edge, options in SI) of the [solver] table."""
+def _solver(solver: Table, units: FileUnits) -> tuple[str, int, float, dict]:
+    """(backend, collocation points per edge, Nitsche penalty, options in SI) of the [solver] table."""
     solver.check(_SOLVER)
     backend = solver.string("backend", "auto", choices=BACKENDS)
     ncol = solver.integer("collocation", 2)
+    gamma = solver.number("nitsche_gamma", NITSCHE_GAMMA)
+    if not gamma > 0:
+        raise solver.error(f"nitsche_gamma (the Nitsche rotation penalty of clamped / symmetry edges, "
+                           f"dimensionless; default {NITSCHE_GAMMA:g}) must be positive, got {gamma!r}")
     opts = {}
     for k in solver:
         kind = _SOLVER[k]
@@ -252,10 +257,10 @@ def _solver(solver: Table, units: FileUnits) -> tuple[str, int, dict]:
         else:
             opts[k] = solver.number(k)
     solver.string("type", "linear", choices=("linear", "nonlinear"))
-    path_keys = set(opts) - {"type", "backend", "collocation"}
+    path_keys = set(opts) - {"type", "backend", "collocation", "nitsche_gamma"}
     if opts.get("type", "linear") == "linear" and path_keys:
         raise solver.error(f"{', '.join(sorted(path_keys))} only apply to type = \"nonlinear\"")
-    return backend, ncol, opts
+    return backend, ncol, gamma, opts
 
 
 def load_problem(path: str | Path) -> ProblemSpec:
@@ -380,10 +385,10 @@ def load_problem(path: str | Path) -> ProblemSpec:
             raise pr.error(f"duplicate probe name {name!r}")
         probes[name] = surface_point(pr, f"probe '{name}'")
 
-    backend, ncol, opts = _solver(doc.table("solver", required=False), units)
+    backend, ncol, gamma, opts = _solver(doc.table("solver", required=False), units)
     ref = doc.table("reference", required=False).check(_REFERENCE)
     try:
-        problem = Problem(shell, loads, supports, probes, n_collocation=ncol)
+        problem = Problem(shell, loads, supports, probes, n_collocation=ncol, nitsche_gamma=gamma)
     except GraspdefError as exc:
         raise type(exc)(f"{p}: {exc}") from None
     return ProblemSpec(problem, str(doc.get("name", p.stem)), units.length, units.force, ls, fs, backend,

@@ -10,7 +10,7 @@ from ..shell.model import Shell
 from ..subdivision.evaluate import SurfaceEvaluator, project_point
 from .loads import PointLoad, load_vector
 from .potentials import EnclosedGas, is_potential
-from .nitsche import NitscheRotation
+from .nitsche import NITSCHE_GAMMA, NitscheRotation
 
 #: net dead load, relative to the loads' magnitude, above which a body held only by rigid_modes is
 #: refused (loads given to 4 digits balance to ~1e-5; MuJoCo's settled grasps to ~1e-6)
@@ -76,6 +76,8 @@ class Problem:
     supports : list of EdgeSupport | PointSupport | RigidModes
     probes : name -> SurfacePoint, where displacements are reported
     n_collocation : collocation points per supported boundary edge
+    nitsche_gamma : dimensionless penalty of the Nitsche rotation terms of clamped / symmetry
+        edges (penalty gamma D / h, :class:`~graspdef.problem.nitsche.NitscheRotation`)
     """
 
     shell: Shell
@@ -83,9 +85,15 @@ class Problem:
     supports: list
     probes: dict[str, SurfacePoint] = field(default_factory=dict)
     n_collocation: int = 2
+    nitsche_gamma: float = NITSCHE_GAMMA
 
     def __post_init__(self) -> None:
         self.evaluator = self.shell.evaluator
+        g = self.nitsche_gamma
+        if (isinstance(g, bool) or not isinstance(g, (int, float, np.integer, np.floating))
+                or not (np.isfinite(g) and g > 0)):
+            raise ProblemError(f"nitsche_gamma (the Nitsche rotation penalty, dimensionless) must be a positive "
+                               f"number, got {g!r}")
         n_real = self.shell.mesh.n_real_faces
         for ld in self.loads:
             if isinstance(ld, PointLoad) and not (0 <= ld.face < n_real):
@@ -144,7 +152,7 @@ class Problem:
         if elastic not in ("finite", "rest"):
             raise ProblemError(f"elastic must be 'finite' or 'rest', got {elastic!r}")
         terms = [ShellElastic(self.shell) if elastic == "finite" else RestQuadratic(self.shell)]
-        nitsche = NitscheRotation(self.shell, self.supports, self.evaluator)
+        nitsche = NitscheRotation(self.shell, self.supports, self.evaluator, self.nitsche_gamma)
         if nitsche:
             terms.append(NitscheTerm(nitsche))
         terms.append(DeadLoads(self.dead_load_vector(), self.shell.rest_positions))
@@ -164,7 +172,7 @@ class Problem:
 
     def boundary_stiffness(self):
         """Nitsche terms for rotation-fixed edges, (3 n_control, 3 n_control) sparse."""
-        return NitscheRotation(self.shell, self.supports, self.evaluator).evaluate(self.shell.rest_positions)[2]
+        return NitscheRotation(self.shell, self.supports, self.evaluator, self.nitsche_gamma).evaluate(self.shell.rest_positions)[2]
 
     def constraints(self, with_targets: bool = False):
         """C (m, 3 n_control) and row labels (and, ``with_targets``, the prescribed values g (m,)

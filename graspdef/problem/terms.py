@@ -13,7 +13,11 @@ Each term is set up completely when it is built (from a shell, by its specificat
 * ``commit(x)``: tell a state-tracking term that ``x`` is a converged state;
 * ``record(x)``: numbers for the path record (e.g. the enclosed gas's volume and pressure);
 * ``internal``: True for the shell's own (elastic and support) forces, which set the force scale
-  of the convergence test.
+  of the convergence test;
+* ``remedy`` (optional, None by default): for a term that is not convex by itself -- e.g. a Nitsche
+  edge term, whose consistency part is bounded only by its penalty -- a sentence naming the
+  setting that restores it; a path that stalls on a mode that such a term makes soft says so
+  (:meth:`graspdef.solve.nonlinear.PathSolver.soft_terms`).
 
 :class:`graspdef.solve.equilibrium.Equilibrium` sums a list of terms and knows none by name;
 :meth:`graspdef.problem.problem.Problem.energy_terms` builds the list of a problem.  A new term
@@ -58,6 +62,7 @@ class TermBase:
     """Defaults: an external (not internal) term with no scaled load, no state, nothing to report."""
 
     internal = False
+    remedy: str | None = None
 
     def load(self, x: np.ndarray) -> np.ndarray | None:
         return None
@@ -113,6 +118,9 @@ class NitscheTerm(TermBase):
 
     def __init__(self, nitsche):
         self.nitsche = nitsche
+        self.remedy = (f"the Nitsche rotation term of the clamped / symmetry edges: its penalty no longer "
+                       f"dominates its edge-moment term there (a spurious mode, not the shell's); raise "
+                       f"[solver] nitsche_gamma (now {nitsche.gamma:g})")
 
     def evaluate(self, x: np.ndarray, lam: float, order: int = 2, u: np.ndarray | None = None) -> TermValue:
         e, g, H = self.nitsche.evaluate(x, order=max(order, 1))

@@ -605,7 +605,7 @@ class PathSolver:
             else:
                 self._arc_length(sol, u)
         except _Failed as exc:
-            sol.stop_reason = str(exc)
+            sol.stop_reason = str(exc) + self.soft_terms(sol.path[-1].u.ravel(), sol.path[-1].load_factor)
         finally:
             self.eq.close()
         sol.timings["total"] = time.perf_counter() - self._t0
@@ -908,6 +908,41 @@ class PathSolver:
                 u_b, lam_b = u_m, lam_m
                 crit = (u_m, lam_m)
         return a_side + b_side[::-1], crit
+
+    #: a term with a ``remedy`` is named at a stall when it takes away at least this fraction of
+    #: the other terms' curvature along the tangent's softest mode
+    SOFT_SHARE = 0.5
+
+    def soft_terms(self, u, lam) -> str:
+        """Why a path stalled at the converged (u, lam), when an energy term that is not convex by
+        itself (one with a ``remedy``, :mod:`graspdef.problem.terms`, e.g. a Nitsche edge term)
+        makes the tangent soft there: its curvature along the softest mode v of the tangent (the
+        eigenvalue closest to zero on the supports' null space, by inverse iteration), v^T H_i v,
+        is negative and cancels at least ``SOFT_SHARE`` of the other terms' -- a spurious mode of
+        the discretisation, not the shell's.  Returns "" otherwise (a physical limit or
+        bifurcation point: the shell's own curvature is what vanishes), or when no term has a
+        remedy (nothing is computed then)."""
+        terms = [t for t in self.eq.terms if getattr(t, "remedy", None)]
+        if not terms or not len(self.eq.terms) > len(terms):
+            return ""
+        try:
+            v = self._critical_mode(u, lam)
+            x = self.eq.X + u.reshape(-1, 3)
+            curv = []
+            for t in self.eq.terms:
+                tv = t.evaluate(x, lam, 2, u)
+                c = float(v @ (tv.hessian @ v)) if tv.hessian is not None else 0.0
+                curv.append(c + sum(ci * float(vi @ v) ** 2 for ci, vi in tv.rank_one))
+        except (SolverError, FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
+            log.info("no softest-mode diagnosis at load factor %.6g (%s)", lam, exc)
+            return ""
+        notes = []
+        for t, c in zip(self.eq.terms, curv):
+            others = sum(ci for tj, ci in zip(self.eq.terms, curv) if tj is not t and ci > 0)
+            if getattr(t, "remedy", None) and c < 0 and -c >= self.SOFT_SHARE * others:
+                notes.append(f"; the tangent's softest mode at load factor {lam:.6g} is made soft by {t.remedy} "
+                             f"(curvature along it: {-c:.3g} taken from the other terms' {others:.3g})")
+        return "".join(notes)
 
     def _critical_mode(self, u, lam, iterations: int = 30, rtol: float = 1e-8) -> np.ndarray:
         """The eigenvector of the tangent (on the supports' null space) whose eigenvalue is closest

@@ -48,6 +48,10 @@ def test_values_with_their_own_units_are_the_same(tmp_path):
     (('name = "centre"', 'name = 3'), r"\[probes 1\] name must be a non-empty string, got 3"),
     (('[[loads]]', '[solver]\ntype = "linear"\nsteps = 3\n[[loads]]'),
      r"p.toml: \[solver\] steps only apply to type = \"nonlinear\""),
+    (('[[loads]]', '[solver]\nnitsche_gamma = 0.0\n[[loads]]'),
+     r"p.toml: \[solver\] nitsche_gamma \(the Nitsche rotation penalty of clamped / symmetry edges, dimensionless; "
+     r"default 20\) must be positive, got 0.0"),
+    (('[[loads]]', '[solver]\nnitsche_gamma = "big"\n[[loads]]'), r"p.toml: \[solver\] nitsche_gamma must be a number"),
     (('[[loads]]', '[solver]\ntype = "nonlin"\n[[loads]]'), r"\[solver\] unknown type 'nonlin' \(did you mean 'nonlinear'\?\)"),
     (('nx = 4', 'nx = 4.0'), r"\[geometry\] nx must be an integer, got 4.0"),
     (('[units]', '[units'), r"p.toml: line \d+, column \d+: not valid TOML"),
@@ -65,3 +69,11 @@ def test_errors_name_file_table_and_key(tmp_path, edit, message):
     with pytest.raises(ProblemError, match=message) as exc:
         _load(tmp_path, text)
     assert "\n" not in str(exc.value)
+
+
+def test_nitsche_gamma_reaches_the_problem_and_applies_to_linear_files(tmp_path):
+    """``[solver] nitsche_gamma`` is a discretisation setting (like ``collocation``), so a linear
+    file takes it too; it sets the Problem's penalty, default 20."""
+    assert _load(tmp_path, BASE).problem.nitsche_gamma == 20.0
+    spec = _load(tmp_path, BASE.replace("[[loads]]", '[solver]\ntype = "linear"\nnitsche_gamma = 80.0\n[[loads]]', 1))
+    assert spec.problem.nitsche_gamma == 80.0
