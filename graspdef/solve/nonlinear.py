@@ -280,7 +280,7 @@ class NonlinearSolution(DisplacementField):
 
 
 class _Failed(Exception):
-    pass
+    diagnosed = False             # the message already says which term made the tangent soft
 
 
 class PathSolver:
@@ -597,6 +597,10 @@ class PathSolver:
                 its = 0
         except (_Failed, SolverError) as exc:
             raise PathStopped(f"no equilibrium at zero load: {exc}", sol) from None
+        if inst is not None and inst > 0 and (soft := self.soft_terms(u, 0.0)):
+            self.eq.close()
+            raise PathStopped(f"the state at zero load is unstable ({inst} negative eigenvalue(s) on the supports' "
+                              f"null space): {soft}", sol)
         sol.path.append(self._record(u, 0.0, st0, its, inst, "start"))
         self.eq.commit(u)
         try:
@@ -605,7 +609,11 @@ class PathSolver:
             else:
                 self._arc_length(sol, u)
         except _Failed as exc:
-            sol.stop_reason = str(exc) + self.soft_terms(sol.path[-1].u.ravel(), sol.path[-1].load_factor)
+            why = str(exc)
+            if not getattr(exc, "diagnosed", False):
+                soft = self.soft_terms(sol.path[-1].u.ravel(), sol.path[-1].load_factor)
+                why += f"; {soft}" if soft else ""
+            sol.stop_reason = why
         finally:
             self.eq.close()
         sol.timings["total"] = time.perf_counter() - self._t0
@@ -738,6 +746,12 @@ class PathSolver:
             is_target = abs(lam_new - nxt) <= 1e-12 * abs(lam_end)
             pt = self._record(u_new, lam_new, st, its, inst, "target" if is_target and nxt != lam_end else "step")
             last = sol.path[-1].instability
+            if last is not None and inst is not None and inst > last and (soft := self.soft_terms(u_new, lam_new)):
+                err = _Failed(f"the tangent lost stability between load factors {lam:.6g} and {lam_new:.6g} "
+                              f"(negative eigenvalues {last} -> {inst}) on a spurious mode: {soft}; the path "
+                              "stops at the last stable point")
+                err.diagnosed = True
+                raise err
             if opt.bifurcation != "report" and last is not None and inst is not None and inst != last:
                 refined, crit = self._locate(u, lam, u_new, lam_new, last)
                 sol.path += refined
@@ -909,40 +923,51 @@ class PathSolver:
                 crit = (u_m, lam_m)
         return a_side + b_side[::-1], crit
 
-    #: a term with a ``remedy`` is named at a stall when it takes away at least this fraction of
-    #: the other terms' curvature along the tangent's softest mode
+    #: a term with a ``remedy`` is named (see :meth:`soft_terms`) when it takes away at least
+    #: SOFT_SHARE of the other terms' curvature along the tangent's softest mode, and at least
+    #: SOFT_REST of the internal terms' curvature at rest along it
     SOFT_SHARE = 0.5
+    SOFT_REST = 0.1
 
     def soft_terms(self, u, lam) -> str:
-        """Why a path stalled at the converged (u, lam), when an energy term that is not convex by
-        itself (one with a ``remedy``, :mod:`graspdef.problem.terms`, e.g. a Nitsche edge term)
-        makes the tangent soft there: its curvature along the softest mode v of the tangent (the
-        eigenvalue closest to zero on the supports' null space, by inverse iteration), v^T H_i v,
-        is negative and cancels at least ``SOFT_SHARE`` of the other terms' -- a spurious mode of
-        the discretisation, not the shell's.  Returns "" otherwise (a physical limit or
-        bifurcation point: the shell's own curvature is what vanishes), or when no term has a
+        """Why the tangent at (u, lam) is soft, when an energy term that is not convex by itself
+        (one with a ``remedy``, :mod:`graspdef.problem.terms`, e.g. a Nitsche edge term) makes it
+        so: along the softest mode v of the tangent (the eigenvalue closest to zero on the
+        supports' null space, by inverse iteration) its curvature v^T H_i v is negative and cancels
+        at least ``SOFT_SHARE`` of the other terms' positive curvature and at least ``SOFT_REST``
+        of the internal terms' curvature at rest (the small-strain stiffness of that mode) -- a
+        spurious mode of the discretisation, not the shell's.  At a physical limit or bifurcation
+        point the shell's own curvature vanishes and such a term's is a small part of the rest
+        stiffness (measured on Euler's clamped strip at P_cr: 6e-8 of 1e-2; on the neo-Hookean
+        pinched cylinder's stall: 1.51 of 1.81).  Returns "" otherwise, or when no term has a
         remedy (nothing is computed then)."""
-        terms = [t for t in self.eq.terms if getattr(t, "remedy", None)]
-        if not terms or not len(self.eq.terms) > len(terms):
+        terms = self.eq.terms
+        if not any(getattr(t, "remedy", None) for t in terms) or all(getattr(t, "remedy", None) for t in terms):
             return ""
         try:
             v = self._critical_mode(u, lam)
             x = self.eq.X + u.reshape(-1, 3)
-            curv = []
-            for t in self.eq.terms:
-                tv = t.evaluate(x, lam, 2, u)
+
+            def curvature(tv):
                 c = float(v @ (tv.hessian @ v)) if tv.hessian is not None else 0.0
-                curv.append(c + sum(ci * float(vi @ v) ** 2 for ci, vi in tv.rank_one))
+                return c + sum(ci * float(vi @ v) ** 2 for ci, vi in tv.rank_one)
+
+            curv = [curvature(t.evaluate(x, lam, 2, u)) for t in terms]
+            zero = np.zeros_like(u)
+            rest = sum(curvature(t.evaluate(self.eq.X, 0.0, 2, zero)) for t in terms
+                       if t.internal and not getattr(t, "remedy", None))
         except (SolverError, FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
             log.info("no softest-mode diagnosis at load factor %.6g (%s)", lam, exc)
             return ""
         notes = []
-        for t, c in zip(self.eq.terms, curv):
-            others = sum(ci for tj, ci in zip(self.eq.terms, curv) if tj is not t and ci > 0)
-            if getattr(t, "remedy", None) and c < 0 and -c >= self.SOFT_SHARE * others:
-                notes.append(f"; the tangent's softest mode at load factor {lam:.6g} is made soft by {t.remedy} "
-                             f"(curvature along it: {-c:.3g} taken from the other terms' {others:.3g})")
-        return "".join(notes)
+        for t, c in zip(terms, curv):
+            others = sum(ci for tj, ci in zip(terms, curv) if tj is not t and ci > 0)
+            if (getattr(t, "remedy", None) and c < 0 and -c >= self.SOFT_SHARE * others
+                    and -c >= self.SOFT_REST * rest):
+                notes.append(f"the tangent's softest mode at load factor {lam:.6g} is made soft by {t.remedy} "
+                             f"(curvature along it: {-c:.3g} taken from the other terms' {others:.3g}; "
+                             f"{rest:.3g} at rest)")
+        return "; ".join(notes)
 
     def _critical_mode(self, u, lam, iterations: int = 30, rtol: float = 1e-8) -> np.ndarray:
         """The eigenvector of the tangent (on the supports' null space) whose eigenvalue is closest
