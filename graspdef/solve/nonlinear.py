@@ -746,12 +746,7 @@ class PathSolver:
             is_target = abs(lam_new - nxt) <= 1e-12 * abs(lam_end)
             pt = self._record(u_new, lam_new, st, its, inst, "target" if is_target and nxt != lam_end else "step")
             last = sol.path[-1].instability
-            if last is not None and inst is not None and inst > last and (soft := self.soft_terms(u_new, lam_new)):
-                err = _Failed(f"the tangent lost stability between load factors {lam:.6g} and {lam_new:.6g} "
-                              f"(negative eigenvalues {last} -> {inst}) on a spurious mode: {soft}; the path "
-                              "stops at the last stable point")
-                err.diagnosed = True
-                raise err
+            self._check_spurious(last, inst, lam, u_new, lam_new)
             if opt.bifurcation != "report" and last is not None and inst is not None and inst != last:
                 refined, crit = self._locate(u, lam, u_new, lam_new, last)
                 sol.path += refined
@@ -886,6 +881,7 @@ class PathSolver:
                     self.eq.commit(u_t)
                     return
             last = sol.path[-1].instability
+            self._check_spurious(last, inst, lam, u_new, lam_new)
             if opt.refine_critical and last is not None and inst is not None and inst != last and mode is None:
                 sol.path += self._bracket(u, lam, dl, du_prev, dlam_prev, last)
             pt = self._record(u_new, lam_new, st, its, inst, "step" if mode is None else "branch")
@@ -968,6 +964,20 @@ class PathSolver:
                              f"(curvature along it: {-c:.3g} taken from the other terms' {others:.3g}; "
                              f"{rest:.3g} at rest)")
         return "; ".join(notes)
+
+    def _check_spurious(self, last, inst, lam, u_new, lam_new) -> None:
+        """Stop the path (at its last point, lam) when the tangent lost stability between it and the
+        converged (u_new, lam_new) on a mode that a term with a remedy makes soft (:meth:`soft_terms`):
+        what follows would be the artefact's branch."""
+        if last is None or inst is None or inst <= last:
+            return
+        soft = self.soft_terms(u_new, lam_new)
+        if soft:
+            err = _Failed(f"the tangent lost stability between load factors {lam:.6g} and {lam_new:.6g} "
+                          f"(negative eigenvalues {last} -> {inst}) on a spurious mode: {soft}; the path "
+                          "stops at the last stable point")
+            err.diagnosed = True
+            raise err
 
     def _critical_mode(self, u, lam, iterations: int = 30, rtol: float = 1e-8) -> np.ndarray:
         """The eigenvector of the tangent (on the supports' null space) whose eigenvalue is closest
