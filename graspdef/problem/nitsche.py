@@ -54,7 +54,9 @@ class NitscheRotation:
     bound: the tangent gets a spurious soft mode at the edge and the energy is unbounded below
     along it.  Measured on the neo-Hookean pinched cylinder (1/8 model, 48 x 48, load point on two
     symmetry edges): with gamma = 20 the path stalls at -W_A = 20.3, where the softest mode's
-    curvature is +1.54 from the shell and -1.51 from this term; with 100 it passes."""
+    curvature is +1.54 from the shell and -1.51 from this term; with 100 and 300 it stalls later
+    (load factors 0.806, 0.9575) on such modes, with 1000 it runs to the end.  The path solver
+    names this term where it makes the tangent soft (``NitscheTerm.remedy``)."""
 
     def __init__(self, shell: Shell, supports: list, ev: SurfaceEvaluator, gamma: float = NITSCHE_GAMMA,
                  n_points: int = 3):
