@@ -597,10 +597,14 @@ class PathSolver:
                 its = 0
         except (_Failed, SolverError) as exc:
             raise PathStopped(f"no equilibrium at zero load: {exc}", sol) from None
-        if inst is not None and inst > 0 and (soft := self.soft_terms(u, 0.0)):
+        if inst is not None and inst > 0:
+            # a path cannot start from an unstable state: a mechanism, or a term not convex at rest
+            # (named if it makes the softest mode soft; else each term with a remedy is listed)
+            soft = self.soft_terms(u, 0.0) or "; ".join(
+                f"possibly {t.remedy}" for t in self.eq.terms if getattr(t, "remedy", None))
             self.eq.close()
             raise PathStopped(f"the state at zero load is unstable ({inst} negative eigenvalue(s) on the supports' "
-                              f"null space): {soft}", sol)
+                              f"null space){': ' + soft if soft else ': a mechanism, or a term that is not convex at rest'}", sol)
         sol.path.append(self._record(u, 0.0, st0, its, inst, "start"))
         self.eq.commit(u)
         try:
