@@ -56,6 +56,7 @@ class State:
     load: np.ndarray
     internal: np.ndarray | None = None      # elastic forces dE/dx + dPi_N/dx (the force scale)
     floor: float | None = None               # round-off level of |gradient| (order 2 only), see roundoff_floor
+    terms: list | None = None                # each term's TermValue, in order (``keep_terms`` only)
 
 
 #: Factor of :func:`roundoff_floor`: its estimate is the standard deviation of the gradient's
@@ -110,16 +111,19 @@ class Equilibrium:
         self.kkt.close()
 
     # ---- energy and derivatives -------------------------------------------------------------
-    def evaluate(self, u: np.ndarray, lam: float, order: int = 2) -> State:
+    def evaluate(self, u: np.ndarray, lam: float, order: int = 2, keep_terms: bool = False) -> State:
         """Pi, grad Pi, Hessian (order 2) and q at displacement u (3n,) and load factor lam: the
-        sums over the terms, in their order."""
+        sums over the terms, in their order (``keep_terms``: each term's part too, ``State.terms``)."""
         x = self.X + u.reshape(-1, 3)
         E = None
         grad = H = internal = None
         rank_one: list = []
         q = np.zeros(self.n)
+        parts = [] if keep_terms else None
         for t in self.terms:
             v = t.evaluate(x, lam, order, u)
+            if parts is not None:
+                parts.append(v)
             E = v.value if E is None else E + v.value
             if order >= 1:
                 grad = v.gradient if grad is None else grad + v.gradient
@@ -136,7 +140,7 @@ class Equilibrium:
         self.n_hessians += order == 2
         if floor is not None:
             self.floor = floor
-        return State(float(E), grad, H if order == 2 else None, rank_one, q, internal, floor)
+        return State(float(E), grad, H if order == 2 else None, rank_one, q, internal, floor, parts)
 
     def energy(self, u: np.ndarray, lam: float) -> float:
         return self.evaluate(u, lam, order=0).energy

@@ -748,9 +748,9 @@ class PathSolver:
                 softening = False                             # a plain step: nothing ahead
             plain = True
             is_target = abs(lam_new - nxt) <= 1e-12 * abs(lam_end)
-            pt = self._record(u_new, lam_new, st, its, inst, "target" if is_target and nxt != lam_end else "step")
             last = sol.path[-1].instability
             self._check_spurious(last, inst, lam, u_new, lam_new)
+            pt = self._record(u_new, lam_new, st, its, inst, "target" if is_target and nxt != lam_end else "step")
             if opt.bifurcation != "report" and last is not None and inst is not None and inst != last:
                 refined, crit = self._locate(u, lam, u_new, lam_new, last)
                 sol.path += refined
@@ -945,14 +945,14 @@ class PathSolver:
         if not any(getattr(t, "remedy", None) for t in terms) or all(getattr(t, "remedy", None) for t in terms):
             return ""
         try:
-            v = self._critical_mode(u, lam)
-            x = self.eq.X + u.reshape(-1, 3)
+            st = self.eq.evaluate(u, lam, 2, keep_terms=True)       # the sum, and each term's part
+            v = self._critical_mode(u, lam, st)
 
             def curvature(tv):
                 c = float(v @ (tv.hessian @ v)) if tv.hessian is not None else 0.0
                 return c + sum(ci * float(vi @ v) ** 2 for ci, vi in tv.rank_one)
 
-            curv = [curvature(t.evaluate(x, lam, 2, u)) for t in terms]
+            curv = [curvature(tv) for tv in st.terms]
             zero = np.zeros_like(u)
             rest = sum(curvature(t.evaluate(self.eq.X, 0.0, 2, zero)) for t in terms
                        if t.internal and not getattr(t, "remedy", None))
@@ -983,11 +983,12 @@ class PathSolver:
             err.diagnosed = True
             raise err
 
-    def _critical_mode(self, u, lam, iterations: int = 30, rtol: float = 1e-8) -> np.ndarray:
+    def _critical_mode(self, u, lam, state=None, iterations: int = 30, rtol: float = 1e-8) -> np.ndarray:
         """The eigenvector of the tangent (on the supports' null space) whose eigenvalue is closest
         to zero at (u, lam) -- the critical mode just past a bifurcation point -- by inverse
-        iteration on the KKT factorisation (each iteration one back-substitution)."""
-        st = self.eq.evaluate(u, lam, 2)
+        iteration on the KKT factorisation (each iteration one back-substitution); ``state``: the
+        order-2 state at (u, lam) if the caller has it."""
+        st = self.eq.evaluate(u, lam, 2) if state is None else state
         self.eq.factor(st)
         rng = np.random.default_rng(0)                    # a fixed start: reproducible
         v = rng.standard_normal(self.eq.n)
