@@ -47,6 +47,8 @@ def run(args: argparse.Namespace) -> int:
             sol = solve_nonlinear(spec.problem, path_options(spec.solver), backend=backend,
                                   progress=lambda info: _path_progress(args, info))
         except PathStopped as exc:
+            if not exc.solution.path:                # nothing converged (refused at zero load): nothing to write
+                raise
             sol, stopped = exc.solution, exc
         progress(args, f"path: {len(sol.path) - 1} points, {sol.n_factorisations} factorisations, "
                        f"{sol.timings.get('total', 0.0):.1f} s")

@@ -33,7 +33,8 @@ from graspdef.solve.nonlinear import PathStopped, path_options, solve_nonlinear
 FILE = Path(__file__).resolve().parents[2] / "benchmarks" / "nonlinear" / "pinched_cylinder_large_neo_hookean.toml"
 
 
-def _spec(tmp_path, gamma, n=12):
+def _write(tmp_path, gamma, n=12):
+    """The benchmark file on n x n cells with nitsche_gamma = gamma (no reference), its path."""
     text = FILE.read_text().split("[reference]")[0]
     for a, b in (("n_theta = 48", f"n_theta = {n}"), ("n_z = 48", f"n_z = {n}"), ("steps = 180", "steps = 20")):
         assert a in text, a
@@ -42,7 +43,11 @@ def _spec(tmp_path, gamma, n=12):
     assert f"nitsche_gamma = {gamma!r}" in text
     f = tmp_path / f"pc_nh{n}_{gamma}.toml"
     f.write_text(text)
-    spec = load_problem(f)
+    return f
+
+
+def _spec(tmp_path, gamma, n=12):
+    spec = load_problem(_write(tmp_path, gamma, n))
     assert spec.problem.nitsche_gamma == gamma
     return spec
 
@@ -98,3 +103,16 @@ def test_a_bad_penalty_is_one_clear_line(gamma):
                                            r"positive number") as exc:
         Problem(sh, [], [EdgeSupport("clamped", lambda x: x[:, 0] < 1e-9)], nitsche_gamma=gamma)
     assert "\n" not in str(exc.value)
+
+
+def test_graspdef_solve_refuses_an_unstable_zero_load_state_in_one_line(tmp_path, capsys):
+    """The command line with the gamma = 8 file: exit 2, one line naming the setting, no run folder
+    (it used to crash with an IndexError on the empty path)."""
+    from graspdef.cli import main
+
+    f = _write(tmp_path, 8.0, n=12)
+    code = main(["-q", "solve", str(f), "--out", str(tmp_path / "run")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert err.count("\n") == 0 and "state at zero load is unstable" in err and "nitsche_gamma (now 8)" in err, err
+    assert not (tmp_path / "run").exists()
