@@ -94,19 +94,28 @@ def same_array(a: np.ndarray, b: np.ndarray) -> bool:
 class _UpperMap:
     """Where K's upper-triangle entries and C^T's entries go in :func:`kkt_upper`'s matrix, for
     one sparsity pattern of K: later matrices on the same pattern (Newton iterations) only
-    gather their values."""
+    gather their values.  The pattern is built by a compiled kernel
+    (:func:`graspdef.solve._kernels.kkt_upper_pattern`: 10k pinched cylinder, 3.3 M non-zeros of
+    K, 0.25 s in numpy before)."""
 
     def __init__(self, K: sp.csr_matrix, C: sp.spmatrix):
+        from graspdef.solve._kernels import kkt_upper_pattern
+
         self.indptr, self.indices = K.indptr, K.indices
-        U = kkt_upper(sp.csr_matrix((np.arange(1, K.nnz + 1, dtype=float), K.indices, K.indptr), shape=K.shape),
-                      C, 1.0)
-        self.shape = U.shape
-        self.U_indptr, self.U_indices = U.indptr, U.indices
-        is_k = U.indices < K.shape[0]
+        n, m = K.shape[0], C.shape[0]
+        Ct = C.T.tocsr()
+        Ct.sort_indices()
+        self.shape = (n + m, n + m)
+        self.U_indptr, self.U_indices, src = kkt_upper_pattern(
+            K.indptr.astype(np.int64, copy=False), K.indices.astype(np.int64, copy=False),
+            Ct.indptr.astype(np.int64, copy=False), Ct.indices.astype(np.int64, copy=False), n, m)
+        is_k = src >= 0
         self.pos_k = np.flatnonzero(is_k)
-        self.src_k = U.data[is_k].astype(np.int64) - 1          # K.data index of each upper entry
-        self.pos_c = np.flatnonzero(~is_k & (U.data != 0))
-        self.c_data = U.data[self.pos_c]
+        self.src_k = src[is_k]                                   # K.data index of each upper entry
+        c = np.flatnonzero((src < 0) & (src > -(Ct.nnz + 1)))
+        keep = Ct.data[-1 - src[c]] != 0
+        self.pos_c = c[keep]
+        self.c_data = Ct.data[-1 - src[self.pos_c]]
 
     def matches(self, K: sp.csr_matrix) -> bool:
         return (same_array(K.indptr, self.indptr) and same_array(K.indices, self.indices)) or (
@@ -124,28 +133,7 @@ def kkt_upper(K: sp.spmatrix, C: sp.spmatrix, scale: float) -> sp.csr_matrix:
     """Upper triangle of the KKT matrix with an explicit (zero) diagonal in the constraint block,
     as PARDISO's symmetric modes want it; built without forming the full matrix."""
     K = K.tocsr()
-    n, m = K.shape[0], C.shape[0]
-    rows = np.repeat(np.arange(n), np.diff(K.indptr))
-    up = K.indices >= rows                                   # upper triangle of K, row by row
-    Ct = (scale * C.T).tocsr()
-    Ct.sort_indices()
-    # row i of U: K's upper entries, then C^T's entries (columns n..n+m); then m zero diagonals
-    cnt = np.bincount(rows[up], minlength=n) + np.diff(Ct.indptr)
-    indptr = np.concatenate([[0], np.cumsum(np.concatenate([cnt, np.ones(m, np.int64)]))])
-    indices = np.empty(indptr[-1], np.int64)
-    data = np.empty(indptr[-1])
-    ku = np.diff(np.concatenate([[0], np.cumsum(np.bincount(rows[up], minlength=n))]))
-    start = indptr[:n]
-    pos_k = start[rows[up]] + (np.arange(up.sum()) - np.repeat(np.cumsum(ku) - ku, ku))
-    indices[pos_k] = K.indices[up]
-    data[pos_k] = K.data[up]
-    crow = np.repeat(np.arange(n), np.diff(Ct.indptr))
-    pos_c = start[crow] + ku[crow] + (np.arange(Ct.nnz) - Ct.indptr[crow])
-    indices[pos_c] = n + Ct.indices
-    data[pos_c] = Ct.data
-    indices[indptr[n:-1]] = n + np.arange(m)
-    data[indptr[n:-1]] = 0.0
-    return sp.csr_matrix((data, indices, indptr), shape=(n + m, n + m))
+    return _UpperMap(K, C).upper(K, scale)
 
 
 class KKTSystem:
