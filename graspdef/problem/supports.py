@@ -378,7 +378,13 @@ def _rebased(A: np.ndarray, cond_max: float) -> tuple[np.ndarray, np.ndarray]:
     Returns (indices of the rows kept, (k, c) replacement rows)."""
     from scipy.linalg import qr
 
-    U, sv, Vt = np.linalg.svd(A, full_matrices=False)
+    # A = R^T Q^T (QR of A^T, Q's r columns an orthonormal basis of the row space): everything
+    # below works on the r x r matrix R^T in that basis -- the same singular values and left
+    # singular vectors as A's, a third of the cost of A's SVD (a 279 x 560 cluster of the 10k
+    # pinched cylinder's diaphragm rows)
+    Q, R = np.linalg.qr(A.T)
+    Rt = R.T
+    U, sv, _ = np.linalg.svd(Rt)
     r = len(sv)
     k = int((sv < sv[0] / cond_max).sum())
     if k == 0:
@@ -387,12 +393,15 @@ def _rebased(A: np.ndarray, cond_max: float) -> tuple[np.ndarray, np.ndarray]:
         piv = qr(U[:, r - k:].T, mode="r", pivoting=True)[1]
         drop = np.zeros(r, bool)
         drop[piv[:k]] = True
-        M = A[~drop] @ Vt.T                       # B's rows in the orthonormal basis Vt
-        _, sm, W = np.linalg.svd(M)
+        M = Rt[~drop]                             # the kept rows B in the basis Q
+        sm = np.linalg.svd(M, compute_uv=False)
         if sm[0] <= cond_max * sm[-1]:
-            return np.flatnonzero(~drop), W[r - k:] @ Vt       # orthogonal to B, in the row space
+            # an orthonormal basis of the part of the row space orthogonal to the kept rows: the
+            # last k columns of the complete QR of M^T, back in A's coordinates
+            W = np.linalg.qr(M.T, mode="complete")[0][:, r - k:]
+            return np.flatnonzero(~drop), W.T @ Q.T
         k *= 2
-    return np.zeros(0, np.int64), Vt
+    return np.zeros(0, np.int64), Q.T
 
 
 def well_conditioned_rows(C: sp.csr_matrix, labels: list, g: np.ndarray, rtol: float = 1e-9,
