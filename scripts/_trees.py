@@ -1,6 +1,6 @@
 """The code trees a benchmark script compares: the working tree (NEW) and, given a git ref, that
 ref's code checked out into a temporary worktree (OLD), removed afterwards.  Used by the scripts
-with ``--ref`` (bench_nonlinear_speed.py, bench_grasp_speed.py)."""
+with ``--ref`` (bench_speed.py, bench_nonlinear_speed.py, bench_grasp_speed.py)."""
 from __future__ import annotations
 
 import contextlib

@@ -13,17 +13,26 @@ several times; medians are reported:
 Targets (issue 2): 10,000 control vertices, assembly + solve <= 2 s; 100,000 control vertices
 <= 60 s and <= 8 GB.  Writes ``bench_speed.json`` to ``--out``.
 
-    python scripts/bench_speed.py [--sizes 70 224] [--repeats 5 3] [--out out/bench_speed]
+    python scripts/bench_speed.py [--sizes 70 224] [--repeats 5 3] [--ref GIT_REF --rounds 3] [--out out/bench_speed]
+
+``--ref GIT_REF``: also measure the OLD code of that git ref (a temporary worktree, scripts/_trees.py),
+OLD and NEW processes alternating ``--rounds`` times per size; the table then has a row per tree and
+the medians are over all of that tree's timed runs.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
 import time
 from pathlib import Path
+
+from _trees import code_trees       # scripts/_trees.py: the working tree and --ref's worktree
+
+ROOT = Path(__file__).resolve().parents[1]
 
 CHILD = r"""
 import json, sys, time
@@ -52,44 +61,65 @@ print(json.dumps({"runs": runs, "peak_MB": peak}))
 """
 
 
-def measure(n_z: int, repeats: int) -> dict:
-    t0 = time.perf_counter()
-    out = subprocess.run([sys.executable, "-c", CHILD, str(n_z), str(repeats), str(Path(__file__).parent)], capture_output=True,
-                         text=True, check=True)
-    data = json.loads(out.stdout.strip().splitlines()[-1])
-    runs = data["runs"]
+def _child(n_z: int, repeats: int, tree: Path) -> dict:
+    """One fresh process of ``tree``'s code: ``repeats`` timed solves after a warm-up."""
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    out = subprocess.run([sys.executable, "-c", CHILD, str(n_z), str(repeats), str(tree / "scripts")],
+                         capture_output=True, text=True, check=True, cwd=tree, env=env)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def summarise(n_z: int, data: list[dict], t0: float) -> dict:
+    """Medians over the timed runs of one or more processes of one tree."""
+    runs = [r for d in data for r in d["runs"]]
     med = {k: statistics.median(r[k] for r in runs) for k in ("setup", "assembly", "solve", "factor")}
     first = runs[0]
     return {"n_z": n_z, "n_control": first["n_control"], "n_dofs": first["n_dofs"],
             "n_constraints": first["m"], "backend": first["backend"], "repeats": len(runs),
-            "median": med, "assembly_plus_solve": med["assembly"] + med["solve"],
-            "total": med["setup"] + med["assembly"] + med["solve"], "peak_MB": data["peak_MB"],
+            "median": med, "assembly_plus_solve": statistics.median(r["assembly"] + r["solve"] for r in runs),
+            "total": med["setup"] + med["assembly"] + med["solve"], "peak_MB": max(d["peak_MB"] for d in data),
             "u_A": first["u_A"], "rel_error": (first["u_A"] - 1.8248e-5) / 1.8248e-5,
             "wall_s": time.perf_counter() - t0}
+
+
+def measure(n_z: int, repeats: int, tree: Path = ROOT) -> dict:
+    t0 = time.perf_counter()
+    return summarise(n_z, [_child(n_z, repeats, tree)], t0)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--sizes", type=int, nargs="+", default=[70, 224], help="n_z values (n_theta = 2 n_z)")
     ap.add_argument("--repeats", type=int, nargs="+", default=[5, 3], help="timed runs per size")
+    ap.add_argument("--ref", help="git ref of the OLD code to measure beside the working tree")
+    ap.add_argument("--rounds", type=int, default=3, help="with --ref: OLD/NEW processes alternating per size")
     ap.add_argument("--out", default="out/bench_speed")
     a = ap.parse_args()
     reps = a.repeats + [a.repeats[-1]] * (len(a.sizes) - len(a.repeats))
     rows = []
-    for n_z, r in zip(a.sizes, reps):
-        print(f"pinched cylinder n_z={n_z}: {r} timed runs ...", file=sys.stderr, flush=True)
-        rows.append(measure(n_z, r))
-    print("| control vertices | dofs | set-up [s] | assembly [s] | solve [s] (factor) | assembly + solve [s] | peak memory [MB] | u_A error |")
-    print("|---|---|---|---|---|---|---|---|")
+    with code_trees(ROOT, a.ref, prefix="bench_speed_") as trees:
+        for n_z, r in zip(a.sizes, reps):
+            rounds = a.rounds if a.ref else 1
+            print(f"pinched cylinder n_z={n_z}: {rounds} x {r} timed runs per tree ({', '.join(trees)}) ...",
+                  file=sys.stderr, flush=True)
+            data, t0 = {name: [] for name in trees}, time.perf_counter()
+            for _ in range(rounds):
+                for name, tree in trees.items():          # OLD first, then NEW, alternating
+                    data[name].append(_child(n_z, r, tree))
+            for name in trees:
+                rows.append({"tree": name, **summarise(n_z, data[name], t0)})
+    print("| code | control vertices | dofs | set-up [s] | assembly [s] | solve [s] (factor) | assembly + solve [s] | peak memory [MB] | u_A error |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for x in rows:
         m = x["median"]
-        print(f"| {x['n_control']} | {x['n_dofs']} | {m['setup']:.2f} | {m['assembly']:.2f} | "
+        print(f"| {x['tree']} | {x['n_control']} | {x['n_dofs']} | {m['setup']:.2f} | {m['assembly']:.2f} | "
               f"{m['solve']:.2f} ({m['factor']:.2f}) | {x['assembly_plus_solve']:.2f} | {x['peak_MB']:.0f} | "
               f"{100 * x['rel_error']:+.3f} % |")
-    print(f"medians of {', '.join(str(x['repeats']) for x in rows)} runs (after one warm-up run each), backend {rows[0]['backend']}")
+    print(f"medians of {', '.join(str(x['repeats']) for x in rows)} timed runs (each process after one warm-up run), "
+          f"backend {rows[0]['backend']}" + (f"; OLD = {a.ref}" if a.ref else ""))
     o = Path(a.out)
     o.mkdir(parents=True, exist_ok=True)
-    (o / "bench_speed.json").write_text(json.dumps(rows, indent=2) + "\n")
+    (o / "bench_speed.json").write_text(json.dumps({"ref": a.ref, "rows": rows}, indent=2) + "\n")
 
 
 if __name__ == "__main__":
