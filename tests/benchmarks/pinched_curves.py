@@ -13,10 +13,14 @@ def at(records, quantity, level):
 
 
 def along_kl_curve(name, n_levels, material, w_a_pmax, u_b_pmax):
-    """Run a pinched-cylinder file; every judged point (nligaStruct's KL curve in ``material``)
-    passes, -W_A at P_max within 0.5 % and U_B within 1 % of the given values, and the S4R
-    context is reported, never judged; returns the records."""
-    records = run_nonlinear_benchmark(NL / name)
+    """Run a pinched-cylinder file and :func:`check_kl_curve` its records; returns them."""
+    return check_kl_curve(run_nonlinear_benchmark(NL / name), n_levels, material, w_a_pmax, u_b_pmax)
+
+
+def check_kl_curve(records, n_levels, material, w_a_pmax, u_b_pmax):
+    """Every judged point of a pinched-cylinder file's records (nligaStruct's KL curve in
+    ``material``) passes, -W_A at P_max within 0.5 % and U_B within 1 % of the given values, and
+    the S4R context is reported, never judged; returns the records."""
     judged = [r for r in records if r["tolerance"] is not None]
     assert len(judged) == 2 * n_levels
     assert all("nligaStruct" in r["source"] and material in r["source"] for r in judged)
