@@ -232,3 +232,25 @@ def test_fingertips_pick_the_scene_variant():
     assert scene_xml(scene_xml("tennis_ball"), "pad").name == "scene_pad.xml"
     with pytest.raises(ProblemError, match="accepted: pin, pad"):
         scene_xml("tennis_ball", "claw")
+
+
+def test_a_value_with_a_minus_sign_reaches_its_option():
+    """``--E -2MPa``: argparse would take "-2MPa" for an option ("expected one argument"); the
+    CLI joins it to its option so that the value's own check answers.  Plain numbers ("-0.1",
+    "-1e-3") are left to argparse, which accepts them; "--opt=value" is left as it is."""
+    from graspdef.cli import join_negative_values
+
+    assert join_negative_values(["object", "add", "x", "--E", "-2MPa", "--nu", "-0.1", "--thickness", "-1e-3"]) == [
+        "object", "add", "x", "--E=-2MPa", "--nu", "-0.1", "--thickness", "-1e-3"]
+    assert join_negative_values(["--grasp-point", "-.5mm", "--E=-3MPa", "-q"]) == ["--grasp-point=-.5mm", "--E=-3MPa", "-q"]
+    assert join_negative_values(["--out", "dir", "--force", "-"]) == ["--out", "dir", "--force", "-"]
+
+
+def test_a_negative_modulus_is_one_line_about_the_modulus(tmp_path, capsys):
+    """The whole command: the error names the modulus, not argparse's missing argument."""
+    code = main(["-q", "object", "add", "b", "--mesh", str(tmp_path / "none.stl"), "--thickness", "2mm", "--law",
+                 "svk", "--E", "-2MPa", "--nu", "0.3", "--mass", "60g", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "Young's modulus E must be a positive" in err[0] and "-2000000" in err[0], err
+    assert not (tmp_path / "o").exists()

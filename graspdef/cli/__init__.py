@@ -23,6 +23,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import re
 import sys
 from collections.abc import Iterable, Sequence
 
@@ -95,10 +96,33 @@ def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentPars
     return ap
 
 
+#: a value that starts with a minus sign and a digit but is not a plain number ("-2MPa", "-10mm"):
+#: argparse takes it for an option and says "expected one argument" (plain numbers it accepts)
+_NEGATIVE_VALUE = re.compile(r"-\.?\d")
+_PLAIN_NUMBER = re.compile(r"-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+
+
+def join_negative_values(argv: list[str]) -> list[str]:
+    """``--opt -2MPa`` as ``--opt=-2MPa``: the value reaches the option (and its own check, e.g.
+    "E must be positive") instead of argparse's "expected one argument"."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if (a.startswith("--") and "=" not in a and i + 1 < len(argv) and _NEGATIVE_VALUE.match(argv[i + 1])
+                and not _PLAIN_NUMBER.fullmatch(argv[i + 1])):
+            out.append(f"{a}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(a)
+        i += 1
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     """``graspdef ...``: parse, run the subcommand; a GraspdefError or OSError is one line and
     exit status 2."""
-    argv = sys.argv[1:] if argv is None else list(argv)
+    argv = join_negative_values(sys.argv[1:] if argv is None else list(argv))
     command = requested_command(argv)
     args = build_parser([command] if command else []).parse_args(argv)
     from .. import runtime
