@@ -13,7 +13,8 @@ several times; medians are reported:
 Targets (issue 2): 10,000 control vertices, assembly + solve <= 2 s; 100,000 control vertices
 <= 60 s and <= 8 GB.  Writes ``bench_speed.json`` to ``--out``.
 
-    python scripts/bench_speed.py [--sizes 70 224] [--repeats 5 3] [--ref GIT_REF --rounds 3] [--out out/bench_speed]
+    python scripts/bench_speed.py [--sizes 70 224] [--repeats 5 3] [--ref GIT_REF --rounds 3] [--backend pardiso-ooc]
+                                  [--out out/bench_speed]
 
 ``--ref GIT_REF``: also measure the OLD code of that git ref (a temporary worktree, scripts/_trees.py),
 OLD and NEW processes alternating ``--rounds`` times per size; the table then has a row per tree and
@@ -38,6 +39,7 @@ CHILD = r"""
 import json, sys, time
 n_z = int(sys.argv[1]); repeats = int(sys.argv[2])
 sys.path.insert(0, sys.argv[3])
+backend = sys.argv[4] if len(sys.argv) > 4 else "auto"
 from convergence import pinched_cylinder_problem
 from graspdef.solve.linear import solve_linear
 runs = []
@@ -45,7 +47,7 @@ for rep in range(repeats + 1):          # the first run warms caches (numba, imp
     t0 = time.perf_counter()
     pr = pinched_cylinder_problem(n_z)
     t1 = time.perf_counter()
-    sol = solve_linear(pr)
+    sol = solve_linear(pr, backend=backend)
     t = sol.timings
     if rep:
         runs.append({"setup": t1 - t0, "assembly": t["assembly"] + t["loads_constraints"],
@@ -61,10 +63,10 @@ print(json.dumps({"runs": runs, "peak_MB": peak}))
 """
 
 
-def _child(n_z: int, repeats: int, tree: Path) -> dict:
+def _child(n_z: int, repeats: int, tree: Path, backend: str = "auto") -> dict:
     """One fresh process of ``tree``'s code: ``repeats`` timed solves after a warm-up."""
     env = {**os.environ, "PYTHONPATH": str(tree)}
-    out = subprocess.run([sys.executable, "-c", CHILD, str(n_z), str(repeats), str(tree / "scripts")],
+    out = subprocess.run([sys.executable, "-c", CHILD, str(n_z), str(repeats), str(tree / "scripts"), backend],
                          capture_output=True, text=True, check=True, cwd=tree, env=env)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
@@ -93,6 +95,7 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, nargs="+", default=[5, 3], help="timed runs per size")
     ap.add_argument("--ref", help="git ref of the OLD code to measure beside the working tree")
     ap.add_argument("--rounds", type=int, default=3, help="with --ref: OLD/NEW processes alternating per size")
+    ap.add_argument("--backend", default="auto", help="sparse solver: auto, pardiso, pardiso-ooc (out of core), superlu")
     ap.add_argument("--out", default="out/bench_speed")
     a = ap.parse_args()
     reps = a.repeats + [a.repeats[-1]] * (len(a.sizes) - len(a.repeats))
@@ -105,7 +108,7 @@ def main() -> None:
             data, t0 = {name: [] for name in trees}, time.perf_counter()
             for _ in range(rounds):
                 for name, tree in trees.items():          # OLD first, then NEW, alternating
-                    data[name].append(_child(n_z, r, tree))
+                    data[name].append(_child(n_z, r, tree, a.backend))
             for name in trees:
                 rows.append({"tree": name, **summarise(n_z, data[name], t0)})
     print("| code | control vertices | dofs | set-up [s] | assembly [s] | solve [s] (factor) | assembly + solve [s] | peak memory [MB] | u_A error |")

@@ -13,7 +13,8 @@ DESCRIPTION = "Solve a problem file and write result.json, deformed.ply and a co
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("problem", help="problem file (.toml)")
     p.add_argument("--out", required=True, help="output folder (replaced if it exists)")
-    p.add_argument("--backend", choices=["auto", "pardiso", "superlu"], help="sparse solver")
+    p.add_argument("--backend", choices=["auto", "pardiso", "pardiso-ooc", "superlu"],
+                   help="sparse solver (pardiso-ooc: PARDISO with its factor on disk, for problems larger than memory)")
 
 
 def _path_progress(args: argparse.Namespace, info: dict) -> None:
@@ -32,7 +33,7 @@ def run(args: argparse.Namespace) -> int:
     check_output_folder(args.out)                 # before any work, not after the solve
     t0 = time.perf_counter()
     progress(args, f"reading {args.problem}")
-    spec = load_problem(args.problem)
+    spec = load_problem(args.problem, backend=args.backend)
     spec.problem.check_self_equilibrated(where=str(args.problem))
     shell = spec.problem.shell
     progress(args, f"shell: {shell.mesh.n_real} control vertices (+{shell.n_control - shell.mesh.n_real} ghosts), "

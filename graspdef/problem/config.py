@@ -135,7 +135,7 @@ def read_units(doc: Table) -> FileUnits:
     return FileUnits(lu, fu, u.unit("length", "length")[1], u.unit("force", "force")[1])
 
 
-def _geometry(g: Table, units: FileUnits, base: Path):
+def _geometry(g: Table, units: FileUnits, base: Path, out_of_core: bool = False):
     if "type" not in g:
         raise g.error("needs a 'type' (" + ", ".join(_GEOMETRY) + ")")
     kind = g.string("type", choices=_GEOMETRY)
@@ -173,7 +173,7 @@ def _geometry(g: Table, units: FileUnits, base: Path):
             args[k] = g.number(k)
     n_est = _vertex_count(kind, args)
     if n_est is not None:                 # before the mesh is generated: a huge one would exhaust memory
-        check_memory(n_est, f"{g.where()}: this {kind}")
+        check_memory(n_est, f"{g.where()}: this {kind}", out_of_core=out_of_core)
     if kind == "monkey_saddle":   # x^3 - 3 x y^2 = scale z, scale in length^2 (one factor above)
         hw = args.pop("half_width")
         scale = args.pop("scale", 5000.0 * ls) * ls
@@ -263,15 +263,19 @@ def _solver(solver: Table, units: FileUnits) -> tuple[str, int, float, dict]:
     return backend, ncol, gamma, opts
 
 
-def load_problem(path: str | Path) -> ProblemSpec:
-    """Read and validate a problem file; build the Shell and Problem (SI inside)."""
+def load_problem(path: str | Path, backend: str | None = None) -> ProblemSpec:
+    """Read and validate a problem file; build the Shell and Problem (SI inside).  ``backend``:
+    the solver backend that will be used if not the file's (the memory check before the mesh is
+    built allows for "pardiso-ooc", which keeps the factor on disk)."""
     p = Path(path)
     doc = read_toml(p, "problem file")
     doc.check(_TOP, ("geometry", "material", "shell", "supports"))
     units = read_units(doc)
     ls, fs = units.length_scale, units.force_scale
+    solver_raw = doc.get("solver", {})
+    ooc = (backend or (solver_raw.get("backend") if hasattr(solver_raw, "get") else None)) == "pardiso-ooc"
     geo = doc.table("geometry")
-    mesh = _geometry(geo, units, p.parent)
+    mesh = _geometry(geo, units, p.parent, ooc)
     material = _material(doc.table("material"), units)
 
     sh = doc.table("shell").check({"thickness", "quadrature"}, ("thickness",))
@@ -282,7 +286,7 @@ def load_problem(path: str | Path) -> ProblemSpec:
     if nq not in (3, 6, 12):
         raise sh.error(f"must be 3, 6 or 12 points per face, got {nq}", "quadrature")
     interp = geo.boolean("interpolate", None)
-    check_memory(mesh.n_vertices, f"{p}: the mesh")
+    check_memory(mesh.n_vertices, f"{p}: the mesh", out_of_core=ooc)
     shell = Shell(mesh.vertices, mesh.faces, material, thickness, n_quad=nq, interpolate=interp)
 
     regions = doc.table("regions", required=False)

@@ -20,7 +20,7 @@ from .supports import RigidModes, check_rigid_modes, constraint_rows, well_condi
 
 
 #: sparse solver back-ends a problem may ask for (graspdef.solve.sparse implements them)
-BACKENDS = ("auto", "pardiso", "superlu")
+BACKENDS = ("auto", "pardiso", "pardiso-ooc", "superlu")     # pardiso-ooc: PARDISO out of core (graspdef.solve.sparse)
 
 
 @dataclass(frozen=True)

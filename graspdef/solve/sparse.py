@@ -6,7 +6,10 @@
 K is symmetric positive semi-definite (rigid modes), C removes them, so the KKT matrix is
 symmetric indefinite with exactly m negative eigenvalues when K is positive definite on the null
 space of C.  Backends: MKL PARDISO through pypardiso (symmetric indefinite LDL^T with inertia; the
-default, see README for the measurements) and SciPy's SuperLU (fallback, no inertia).
+default, see README for the measurements) and SciPy's SuperLU (fallback, no inertia).  Backend
+"pardiso-ooc" is PARDISO out of core: the factor is written to files in a temporary folder (removed
+when the system is closed) and only :data:`OOC_CORE_MB` of it is held in memory at a time -- for
+problems whose in-core factor does not fit (the 100k pinched cylinder's is 2.8 GB).
 No regularisation is accepted: PARDISO may perturb tiny pivots of the zero constraint block during
 the factorisation, but the solution is then refined iteratively and its residual in the
 *unperturbed* system is checked; a wrong inertia (a mechanism) is reported as an error.
@@ -14,6 +17,9 @@ the factorisation, but the solution is then refined iteratively and its residual
 from __future__ import annotations
 
 import logging
+import os
+import shutil
+import tempfile
 import time
 from dataclasses import dataclass
 
@@ -35,7 +41,7 @@ class KKTResult:
     Attributes
     ----------
     u : (n,) displacements;  multipliers : (m,) constraint forces (Lagrange multipliers)
-    backend : "pardiso" or "superlu";  n_negative : negative pivots (PARDISO) or None
+    backend : "pardiso", "pardiso-ooc" or "superlu";  n_negative : negative pivots (PARDISO) or None
     seconds_factor, seconds_solve : wall times;  residual : ||K u + C^T l - f|| / ||f||
     """
 
@@ -151,7 +157,12 @@ class KKTSystem:
             raise SolverError(f"unknown linear solver backend '{backend}' (valid: {', '.join(BACKENDS)})")
         if backend == "auto":
             backend = "pardiso" if pardiso_available() else "superlu"
+        if backend == "pardiso-ooc" and not pardiso_available():
+            raise SolverError("backend 'pardiso-ooc' needs PARDISO (pypardiso with MKL), which is not available here")
         self.backend = backend
+        self._pardiso = backend in ("pardiso", "pardiso-ooc")
+        self._ooc_dir: str | None = None  # pardiso-ooc: the folder of PARDISO's factor files
+        self.ooc_core_mb = OOC_CORE_MB    # pardiso-ooc: the factor's part held in memory [MB]
         self.C = C.tocsr()
         self.m = self.C.shape[0]
         self._solver = None
@@ -175,9 +186,21 @@ class KKTSystem:
 
     def close(self) -> None:
         if self._solver is not None:
-            self._solver.free_memory(everything=True)
+            with self._ooc_environment():
+                self._solver.free_memory(everything=True)
             self._solver = None
             self._map = None                                # a new solver needs a new analysis
+        if self._ooc_dir is not None:
+            shutil.rmtree(self._ooc_dir, ignore_errors=True)
+            self._ooc_dir = None
+
+    def _ooc_environment(self):
+        """For pardiso-ooc: MKL reads where to put its factor files and how much of the factor to
+        keep in memory from the environment; set both around a PARDISO call and restore them after
+        (no lasting change to the process)."""
+        return _Environment({"MKL_PARDISO_OOC_PATH": self._ooc_dir + os.sep,
+                             "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(self.ooc_core_mb),
+                             "MKL_PARDISO_OOC_KEEP_FILE": "0"} if self._ooc_dir is not None else {})
 
     def factor(self, K: sp.spmatrix, analyse: bool = False) -> None:
         """Factor the KKT matrix of ``K``; ``analyse`` forces a fresh ordering/matching.  A
@@ -188,7 +211,7 @@ class KKTSystem:
         self.n = self.K.shape[0]
         self.scale = constraint_scale(self.K)
         self.norm = kkt_norm(self.K, self.C, self.scale)
-        if self.backend == "pardiso":
+        if self._pardiso:
             self._factor_pardiso(analyse)
         else:
             A, _ = kkt_matrix(self.K, self.C)
@@ -209,17 +232,37 @@ class KKTSystem:
         U = upper_map.upper(K, self.scale)
         if self._solver is None:
             self._solver = _new_pardiso(-2)
-            for k, v in {**_PARDISO_IPARM, **(_PARDISO_ROBUST if self.robust else {})}.items():
+            ooc = {60: 2} if self.backend == "pardiso-ooc" else {}
+            if ooc and self._ooc_dir is None:
+                self._ooc_dir = tempfile.mkdtemp(prefix="graspdef_pardiso_ooc_")
+            for k, v in {**_PARDISO_IPARM, **(_PARDISO_ROBUST if self.robust else {}), **ooc}.items():
                 self._solver.set_iparm(k, v)
         s = self._solver
         s._check_A(U)
         z = np.zeros((U.shape[0], 1))
-        if analyse or new_pattern:
-            s.set_phase(11)                             # analysis (matching, ordering)
-            s._call_pardiso(U, z)
-            self._map = upper_map                       # kept once PARDISO has analysed it
-        s.set_phase(22)                                 # numerical factorisation
-        s._call_pardiso(U, z)
+        try:
+            with self._ooc_environment():
+                if analyse or new_pattern:
+                    s.set_phase(11)                     # analysis (matching, ordering)
+                    s._call_pardiso(U, z)
+                    self._map = upper_map               # kept once PARDISO has analysed it
+                s.set_phase(22)                         # numerical factorisation
+                s._call_pardiso(U, z)
+        except Exception as exc:
+            if self._ooc_dir is None or getattr(exc, "value", None) != -9:
+                raise
+            # -9: the in-memory part allowed is below what PARDISO's out-of-core mode needs for this
+            # matrix (the 100k pinched cylinder: between 600 and 800 MB): double it, analyse again
+            self.close()
+            self.ooc_core_mb *= 2
+            have = _available_mb()
+            if have is not None and self.ooc_core_mb > have:
+                raise SolverError(f"PARDISO out of core needs more than {self.ooc_core_mb // 2} MB of memory for "
+                                  f"this matrix and {have} MB are free: the problem is too large for this "
+                                  "machine") from None
+            log.info("PARDISO out of core: more memory needed, retrying with %d MB", self.ooc_core_mb)
+            self._factor_pardiso(True)
+            return
         self.n_factor += 1
         self._U = U
         self.perturbed = int(s.get_iparm(14))
@@ -243,7 +286,7 @@ class KKTSystem:
     def retry_robust(self) -> bool:
         """Refactor the last matrix with the robust PARDISO settings, if not done yet; returns
         whether it did (the callers' second chance when an inertia or a solve check fails)."""
-        if self.backend != "pardiso" or self.robust or self._solver is None:
+        if not self._pardiso or self.robust or self._solver is None:
             return False
         t0 = time.perf_counter()
         log.info("KKT: refactoring with PARDISO's robust settings after a failed check")
@@ -263,9 +306,10 @@ class KKTSystem:
 
     def _back(self, b: np.ndarray) -> np.ndarray:
         self.n_back += 1 if b.ndim == 1 else b.shape[1]
-        if self.backend == "pardiso":
+        if self._pardiso:
             self._solver.set_phase(33)
-            return self._solver._call_pardiso(self._U, np.asfortranarray(b)).reshape(b.shape)
+            with self._ooc_environment():
+                return self._solver._call_pardiso(self._U, np.asfortranarray(b)).reshape(b.shape)
         return self._lu.solve(b)
 
     def solve(self, f: np.ndarray, g: np.ndarray | None = None, rtol: float = 1e-8,
@@ -360,6 +404,39 @@ def backward_error(norm: float, x: np.ndarray, r: np.ndarray, b: np.ndarray) -> 
 
 
 #: PARDISO settings (1-based iparm): see the README's solver section
+#: pardiso-ooc: the part of the factor PARDISO keeps in memory [MB] (MKL_PARDISO_OOC_MAX_CORE_SIZE;
+#: MKL's default is 2000).  Doubled while PARDISO reports too little (error -9; the 100k pinched
+#: cylinder needs 700-800).
+OOC_CORE_MB = 1000
+
+
+def _available_mb() -> int | None:
+    from ..shell.memory import available_memory
+
+    have = available_memory()
+    return None if have is None else int(have / 2**20)
+
+
+class _Environment:
+    """Set environment variables for a block and restore them after."""
+
+    def __init__(self, values: dict[str, str]):
+        self.values = values
+        self.saved: dict[str, str | None] = {}
+
+    def __enter__(self):
+        for k, v in self.values.items():
+            self.saved[k] = os.environ.get(k)
+            os.environ[k] = v
+
+    def __exit__(self, *exc):
+        for k, v in self.saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
 _PARDISO_IPARM = {
     1: 1,       # use the values below, not the defaults
     2: 3,       # parallel METIS nested-dissection ordering

@@ -1,0 +1,166 @@
+"""PARDISO out of core (backend "pardiso-ooc", graspdef.solve.sparse): the factor goes to files in
+a temporary folder and only OOC_CORE_MB of it stays in memory -- for problems whose in-core factor
+does not fit (README "Speed": the 100k pinched cylinder).  Invariant: it is the same LDL^T
+factorisation, so the solution, the residual check and the inertia are those of the in-core
+solver; the files and the process's environment are left as they were.
+
+Each check runs in a fresh interpreter with at most three out-of-core solvers: MKL's out-of-core
+mode (2026.2) has been seen to crash a process at exit after it created many of them (README,
+"Out of core"), which must not take a test worker down with it."""
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from graspdef.errors import ProblemError
+from graspdef.solve.sparse import pardiso_available
+
+ROOT = Path(__file__).resolve().parents[2]
+needs_pardiso = pytest.mark.skipif(not pardiso_available(), reason="PARDISO (pypardiso + MKL) not installed")
+
+PRELUDE = """
+import json, os, sys
+import numpy as np
+from graspdef.problem.config import load_problem
+from graspdef.solve.linear import rest_stiffness, solve_linear
+from graspdef.solve.sparse import KKTSystem
+from graspdef.testing import plate_problem
+import graspdef.solve.sparse as sparse
+OOC = ("MKL_PARDISO_OOC_PATH", "MKL_PARDISO_OOC_MAX_CORE_SIZE", "MKL_PARDISO_OOC_KEEP_FILE")
+def plate(n):
+    path = os.path.join(sys.argv[1], f"plate{n}.toml")
+    open(path, "w").write(plate_problem(n=n))
+    return load_problem(path).problem
+def system(pr, seed):
+    K = rest_stiffness(pr)
+    C, _, g = pr.constraints(with_targets=True)
+    return K, C, g, np.random.default_rng(seed).standard_normal(K.shape[0])
+out = {}
+"""
+
+
+def _run(tmp_path, body: str) -> dict:
+    """Run PRELUDE + body in a fresh interpreter (the repository on its path); body fills ``out``."""
+    code = PRELUDE + body + "\nprint(json.dumps(out))\n"
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    r = subprocess.run([sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True, env=env,
+                       cwd=tmp_path, timeout=300, check=False)
+    assert r.returncode == 0, r.stderr[-3000:]
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+@needs_pardiso
+def test_out_of_core_solution_equals_the_in_core_one(tmp_path):
+    """The simply supported plate under a centre load: the same displacements (to 1e-10 of the
+    largest), the residual check passed, the same inertia (one negative pivot per constraint);
+    the environment as before.  Then one system factorised twice on one pattern (a Newton
+    iteration's refactorisation): its folder holds the L factor's file while open and is gone
+    after closing."""
+    out = _run(tmp_path, """
+pr = plate(16)
+before = {k: os.environ.get(k) for k in OOC}
+a = solve_linear(pr, backend="pardiso")
+b = solve_linear(pr, backend="pardiso-ooc")
+out["backend"] = b.kkt.backend
+out["du"] = float(np.abs(b.u - a.u).max() / np.abs(a.u).max())
+out["neg"] = [a.kkt.n_negative, b.kkt.n_negative, len(a.kkt.multipliers)]
+out["residual"] = b.kkt.residual
+out["env_same"] = {k: os.environ.get(k) for k in OOC} == before
+K, C, g, f = system(plate(8), 0)
+with KKTSystem(C, "pardiso") as ref:
+    ref.factor(K)
+    u_ref = ref.solve(f, g)[0]
+kkt = KKTSystem(C, "pardiso-ooc")
+out["runs"] = []
+for scale in (1.0, 2.0):
+    kkt.factor(K * scale)
+    folder = kkt._ooc_dir
+    u, _, rel = kkt.solve(f, g)
+    out["runs"].append({"lnz": any("lnz" in n for n in os.listdir(folder)), "rel": rel,
+                        "du": float(np.abs(u * scale - u_ref).max() / np.abs(u_ref).max())})
+kkt.close()
+out["folder_gone"] = not os.path.exists(folder)
+""")
+    assert out["backend"] == "pardiso-ooc"
+    assert out["du"] <= 1e-10
+    assert out["neg"][0] == out["neg"][1] == out["neg"][2]
+    assert out["residual"] <= 1e-8
+    assert out["env_same"]
+    for r in out["runs"]:
+        assert r["lnz"] and r["rel"] <= 1e-8 and r["du"] <= 1e-10, r
+    assert out["folder_gone"]
+
+
+@needs_pardiso
+def test_too_little_memory_for_out_of_core_is_doubled_until_enough(tmp_path):
+    """PARDISO refuses an in-memory part below its minimum for the matrix (error -9); the system
+    doubles it and analyses again (4 MB -> 16 MB for the 40 x 40 plate), with the same solution."""
+    out = _run(tmp_path, """
+sparse.OOC_CORE_MB = 4
+K, C, g, f = system(plate(40), 1)
+with KKTSystem(C, "pardiso") as ref:
+    ref.factor(K)
+    u_ref = ref.solve(f, g)[0]
+with KKTSystem(C, "pardiso-ooc") as kkt:
+    kkt.factor(K)
+    out["core_mb"] = kkt.ooc_core_mb
+    u, _, out["rel"] = kkt.solve(f, g)
+    folder = kkt._ooc_dir
+out["du"] = float(np.abs(u - u_ref).max() / np.abs(u_ref).max())
+out["folder_gone"] = not os.path.exists(folder)
+""")
+    assert out["core_mb"] > 4
+    assert out["rel"] <= 1e-8 and out["du"] <= 1e-10
+    assert out["folder_gone"]
+
+
+@needs_pardiso
+def test_graspdef_solve_out_of_core(tmp_path):
+    """``graspdef solve --backend pardiso-ooc`` (a process of its own): the run folder records the
+    backend and the same centre deflection as the in-core solve (to 1e-10 of it)."""
+    from graspdef.testing import plate_problem
+
+    path = tmp_path / "plate.toml"
+    path.write_text(plate_problem(n=12))
+    w = {}
+    for backend in ("pardiso", "pardiso-ooc"):
+        r = subprocess.run([sys.executable, "-c", "import sys; from graspdef.cli import main; sys.exit(main())",
+                            "-q", "solve", str(path), "--backend", backend,
+                            "--out", str(tmp_path / backend)], capture_output=True, text=True, cwd=tmp_path,
+                           env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=300, check=False)
+        assert r.returncode == 0, r.stderr[-3000:]
+        rec = json.loads((tmp_path / backend / "result.json").read_text())
+        assert rec["solver"]["backend"] == backend
+        w[backend] = rec["probes"]["centre"]["displacement"][2]
+    assert w["pardiso-ooc"] == pytest.approx(w["pardiso"], rel=1e-10, abs=0)
+
+
+def test_the_backend_is_a_problem_file_setting(tmp_path):
+    """[solver] backend = "pardiso-ooc" is accepted; a misspelt one is refused by name."""
+    from graspdef.problem.config import load_problem
+    from graspdef.testing import plate_problem
+
+    path = tmp_path / "p.toml"
+    path.write_text(plate_problem(n=4) + '[solver]\nbackend = "pardiso-ooc"\n')
+    assert load_problem(path).backend == "pardiso-ooc"
+    path.write_text(plate_problem(n=4) + '[solver]\nbackend = "pardiso_ooc"\n')
+    with pytest.raises(ProblemError, match="pardiso-ooc"):
+        load_problem(path)
+
+
+def test_the_memory_check_allows_for_the_factor_on_disk():
+    """A mesh refused in core is told about pardiso-ooc when out of core would fit, and accepted
+    out of core (graspdef.shell.memory: 60 kB per vertex in core, 30 kB out of core, + 0.4 GB)."""
+    from graspdef.shell.memory import check_memory
+
+    have = 2.0 * 2**30                                      # 2 GiB free; 50,000 vertices: 3.4 / 1.9 GB
+    with pytest.raises(ProblemError, match="pardiso-ooc") as exc:
+        check_memory(50_000, "a mesh", available=have)
+    assert "fewer faces" in str(exc.value)
+    assert check_memory(50_000, "a mesh", available=have, out_of_core=True) == pytest.approx(0.4e9 + 50_000 * 30e3)
+    with pytest.raises(ProblemError, match="out of core") as exc:                  # too large either way
+        check_memory(200_000, "a mesh", available=have, out_of_core=True)
+    assert "pardiso-ooc" not in str(exc.value)
