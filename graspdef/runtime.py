@@ -35,6 +35,7 @@ All only fill in environment variables the user has not set.
 """
 from __future__ import annotations
 
+import contextlib
 import glob
 import os
 import sys
@@ -59,3 +60,20 @@ def configure() -> dict:
     return {"OMP_WAIT_POLICY": os.environ["OMP_WAIT_POLICY"], "NUMBA_THREADING_LAYER": os.environ["NUMBA_THREADING_LAYER"],
             "OPENBLAS_NUM_THREADS": os.environ["OPENBLAS_NUM_THREADS"], "blas_threads_fixed": "numpy" not in sys.modules,
             "PYPARDISO_MKL_RT": locate_mkl_rt()}
+
+
+@contextlib.contextmanager
+def environment(values: dict[str, str]):
+    """Set environment variables for a block and restore them after: for libraries that read
+    their settings from the environment at call time (MKL PARDISO's out-of-core folder and memory,
+    graspdef.solve.sparse).  An empty ``values`` changes nothing."""
+    saved = {k: os.environ.get(k) for k in values}
+    try:
+        os.environ.update(values)
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v

@@ -29,7 +29,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import SolverError, SupportError
 from ..problem.problem import BACKENDS
-from ..runtime import locate_mkl_rt
+from ..runtime import environment, locate_mkl_rt
 
 log = logging.getLogger(__name__)
 
@@ -198,7 +198,7 @@ class KKTSystem:
         """For pardiso-ooc: MKL reads where to put its factor files and how much of the factor to
         keep in memory from the environment; set both around a PARDISO call and restore them after
         (no lasting change to the process)."""
-        return _Environment({"MKL_PARDISO_OOC_PATH": self._ooc_dir + os.sep,
+        return environment({"MKL_PARDISO_OOC_PATH": self._ooc_dir + os.sep,
                              "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(self.ooc_core_mb),
                              "MKL_PARDISO_OOC_KEEP_FILE": "0"} if self._ooc_dir is not None else {})
 
@@ -403,7 +403,6 @@ def backward_error(norm: float, x: np.ndarray, r: np.ndarray, b: np.ndarray) -> 
     return float(eta.max()) if eta.size else 0.0
 
 
-#: PARDISO settings (1-based iparm): see the README's solver section
 #: pardiso-ooc: the part of the factor PARDISO keeps in memory [MB] (MKL_PARDISO_OOC_MAX_CORE_SIZE;
 #: MKL's default is 2000).  Doubled while PARDISO reports too little (error -9; the 100k pinched
 #: cylinder needs 700-800).
@@ -417,26 +416,7 @@ def _available_mb() -> int | None:
     return None if have is None else int(have / 2**20)
 
 
-class _Environment:
-    """Set environment variables for a block and restore them after."""
-
-    def __init__(self, values: dict[str, str]):
-        self.values = values
-        self.saved: dict[str, str | None] = {}
-
-    def __enter__(self):
-        for k, v in self.values.items():
-            self.saved[k] = os.environ.get(k)
-            os.environ[k] = v
-
-    def __exit__(self, *exc):
-        for k, v in self.saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-
-
+#: PARDISO settings (1-based iparm): see the README's solver section
 _PARDISO_IPARM = {
     1: 1,       # use the values below, not the defaults
     2: 3,       # parallel METIS nested-dissection ordering
