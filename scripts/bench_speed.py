@@ -84,11 +84,6 @@ def summarise(n_z: int, data: list[dict], t0: float) -> dict:
             "wall_s": time.perf_counter() - t0}
 
 
-def measure(n_z: int, repeats: int, tree: Path = ROOT) -> dict:
-    t0 = time.perf_counter()
-    return summarise(n_z, [_child(n_z, repeats, tree)], t0)
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--sizes", type=int, nargs="+", default=[70, 224], help="n_z values (n_theta = 2 n_z)")

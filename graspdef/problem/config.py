@@ -272,8 +272,9 @@ def load_problem(path: str | Path, backend: str | None = None) -> ProblemSpec:
     doc.check(_TOP, ("geometry", "material", "shell", "supports"))
     units = read_units(doc)
     ls, fs = units.length_scale, units.force_scale
-    solver_raw = doc.get("solver", {})
-    ooc = (backend or (solver_raw.get("backend") if hasattr(solver_raw, "get") else None)) == "pardiso-ooc"
+    # the [solver] table first: its backend decides the memory check before the mesh is built
+    file_backend, ncol, gamma, opts = _solver(doc.table("solver", required=False), units)
+    ooc = (backend or file_backend) == "pardiso-ooc"
     geo = doc.table("geometry")
     mesh = _geometry(geo, units, p.parent, ooc)
     material = _material(doc.table("material"), units)
@@ -389,11 +390,10 @@ def load_problem(path: str | Path, backend: str | None = None) -> ProblemSpec:
             raise pr.error(f"duplicate probe name {name!r}")
         probes[name] = surface_point(pr, f"probe '{name}'")
 
-    backend, ncol, gamma, opts = _solver(doc.table("solver", required=False), units)
     ref = doc.table("reference", required=False).check(_REFERENCE)
     try:
         problem = Problem(shell, loads, supports, probes, n_collocation=ncol, nitsche_gamma=gamma)
     except GraspdefError as exc:
         raise type(exc)(f"{p}: {exc}") from None
-    return ProblemSpec(problem, str(doc.get("name", p.stem)), units.length, units.force, ls, fs, backend,
+    return ProblemSpec(problem, str(doc.get("name", p.stem)), units.length, units.force, ls, fs, file_backend,
                        dict(ref), dict(doc), opts)

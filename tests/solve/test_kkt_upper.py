@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from graspdef.solve.sparse import _UpperMap, kkt_matrix, kkt_upper
+from graspdef.solve.sparse import _UpperMap, kkt_upper
 
 
 def _random_system(n, m, seed, unsorted=False):
@@ -30,7 +30,6 @@ def test_upper_triangle_equals_the_definition(n, m, seed, unsorted):
     K, C = _random_system(n, m, seed, unsorted)
     s = 3.7
     U = kkt_upper(K, C, s)
-    A, _ = kkt_matrix(K, C)
     ref = sp.triu(sp.bmat([[K, s * C.T], [s * C, None]]) if m else K).toarray()
     assert U.shape == (n + m, n + m)
     np.testing.assert_array_equal(U.toarray(), ref)
