@@ -170,7 +170,8 @@ class KKTSystem:
         self._lu = None
         self.n_negative: int | None = None
         self.perturbed = 0
-        self.robust = False               # PARDISO's robust settings in use (see factor)
+        self.variant = 0                  # PARDISO settings in use: 0 the defaults, k the k-th of _PARDISO_FALLBACKS
+        self._tried: set[int] = set()     # variants tried on the current matrix (see retry_robust)
         self.scale = 1.0
         self.seconds_factor = 0.0
         self.seconds_solve = 0.0
@@ -207,6 +208,7 @@ class KKTSystem:
         factorisation that fails a check is redone by :meth:`retry_robust` (the callers' and
         :meth:`solve`'s second chance)."""
         t0 = time.perf_counter()
+        self._tried = {self.variant}
         self.K = K.tocsr()
         self.n = self.K.shape[0]
         self.scale = constraint_scale(self.K)
@@ -235,7 +237,7 @@ class KKTSystem:
             ooc = {60: 2} if self.backend == "pardiso-ooc" else {}
             if ooc and self._ooc_dir is None:
                 self._ooc_dir = tempfile.mkdtemp(prefix="graspdef_pardiso_ooc_")
-            for k, v in {**_PARDISO_IPARM, **(_PARDISO_ROBUST if self.robust else {}), **ooc}.items():
+            for k, v in {**_PARDISO_IPARM, **self._variant_iparm(), **ooc}.items():
                 self._solver.set_iparm(k, v)
         s = self._solver
         s._check_A(U)
@@ -268,29 +270,46 @@ class KKTSystem:
         self.perturbed = int(s.get_iparm(14))
         self.n_negative = int(s.get_iparm(23))
 
-    def _go_robust(self) -> None:
-        """Switch to :data:`_PARDISO_ROBUST` (the next factorisation re-analyses)."""
-        self.robust = True
-        if self._solver is not None:
-            for k, v in _PARDISO_ROBUST.items():
-                self._solver.set_iparm(k, v)
+    @property
+    def robust(self) -> bool:
+        """Whether PARDISO runs with settings other than the defaults (a fallback, see
+        :meth:`retry_robust`)."""
+        return self.variant != 0
+
+    def _variant_iparm(self) -> dict:
+        return dict(_PARDISO_FALLBACKS[self.variant - 1]) if self.variant else {}
 
     def negative_pivots(self, expected: int) -> int | None:
-        """The last factorisation's number of negative pivots; when it is not ``expected``, after
-        one refactorisation with the robust settings (:meth:`retry_robust`).  None: no inertia
-        (SuperLU)."""
-        if self.n_negative is not None and self.n_negative != expected and self.retry_robust():
+        """The last factorisation's number of negative pivots; when it is not ``expected`` and the
+        default settings are in use, after one refactorisation with the first fallback settings
+        (:meth:`retry_robust`; an unstable state is so confirmed once per system, not at every
+        unstable point of a path).  None: no inertia (SuperLU)."""
+        if self.n_negative is not None and self.n_negative != expected and not self.robust and self.retry_robust():
             log.info("KKT: %d negative pivots for %d expected with the robust settings", self.n_negative, expected)
         return self.n_negative
 
     def retry_robust(self) -> bool:
-        """Refactor the last matrix with the robust PARDISO settings, if not done yet; returns
-        whether it did (the callers' second chance when an inertia or a solve check fails)."""
-        if not self._pardiso or self.robust or self._solver is None:
+        """Refactor the last matrix with the next PARDISO settings not yet tried on it -- the
+        defaults and each of :data:`_PARDISO_FALLBACKS`, in turn from the ones in use -- and keep
+        them for the next factorisations; returns whether it did (False: every variant has been
+        tried on this matrix).  The callers' second (and third) chance when an inertia or a solve
+        check fails.  Every variant is tried, the defaults included, because no one of them is
+        backward-stable on every matrix: on a quarter half-can's path (scripts/can_half_study.py)
+        the standard matching, switched to at one point, solved a later tangent to a residual of
+        1e-2 that the defaults solve to 3e-12."""
+        if not self._pardiso or self._solver is None:
+            return False
+        n_var = 1 + len(_PARDISO_FALLBACKS)
+        nxt = next(((self.variant + k) % n_var for k in range(1, n_var) if (self.variant + k) % n_var not in self._tried), None)
+        if nxt is None:
             return False
         t0 = time.perf_counter()
-        log.info("KKT: refactoring with PARDISO's robust settings after a failed check")
-        self._go_robust()
+        log.info("KKT: refactoring with PARDISO settings %s after a failed check", _PARDISO_FALLBACKS[nxt - 1] if nxt else "(defaults)")
+        self._tried.add(nxt)
+        self.variant = nxt
+        with self._ooc_environment():
+            self._solver.free_memory(everything=True)      # a fresh solver: every iparm from the variant
+        self._solver = None
         self._factor_pardiso(True)
         self.seconds_factor += time.perf_counter() - t0
         return True
@@ -442,7 +461,11 @@ _PARDISO_IPARM = {
 #: such case here (tests/solve/test_kkt_robust.py).  Perturbed pivots alone do not trigger it: the fast
 #: settings perturb tiny pivots of the zero constraint block routinely (the pinched cylinder, the
 #: patch model) and the refined solution then passes its check.
+#: The settings tried after the defaults when a check fails, in this order (:meth:`KKTSystem.retry_robust`):
+#: the standard weighted matching (above), then the minimum-degree ordering instead of METIS (which
+#: factored the soda can's and the half-can's failing tangents exactly as well).
 _PARDISO_ROBUST = {13: 1}
+_PARDISO_FALLBACKS = (_PARDISO_ROBUST, {2: 0})
 
 
 def solve_kkt(K: sp.spmatrix, C: sp.spmatrix, f: np.ndarray, backend: str = "auto",

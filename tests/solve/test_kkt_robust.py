@@ -10,7 +10,9 @@ differs (another basis of the same rows) and PARDISO, with the improved matching
 negative pivots for 960 constraints, while SciPy's SuperLU solved the same matrix to 1.5e-11 with
 the same displacements.  The standard matching factors it exactly.  A factorisation that perturbs
 a pivot, a solve that fails its residual/backward-error check and a linear problem whose inertia
-is wrong are therefore redone once with ``_PARDISO_ROBUST`` before anything is refused.
+is wrong are therefore redone with ``_PARDISO_FALLBACKS`` before anything is refused -- a failed
+solve with every variant not yet tried on that matrix, the defaults included (a later tangent of the
+same path may need them back), a wrong inertia once.
 """
 import json
 import os
@@ -56,12 +58,12 @@ def test_a_failed_solve_is_redone_with_the_robust_settings(monkeypatch, seed):
     K, C, f = _saddle(seed=seed)
     for k, v in UNSTABLE.items():
         monkeypatch.setitem(S._PARDISO_IPARM, k, v)
-    monkeypatch.setattr(S, "_PARDISO_ROBUST", {})            # nowhere to go: the failure itself
+    monkeypatch.setattr(S, "_PARDISO_FALLBACKS", ())         # nowhere to go: the failure itself
     with S.KKTSystem(C, "pardiso") as fast:
         fast.factor(K)
         with pytest.raises(S.SolverError, match="residual"):
             fast.solve(f)
-    monkeypatch.setattr(S, "_PARDISO_ROBUST", {10: 8, 13: 1})
+    monkeypatch.setattr(S, "_PARDISO_FALLBACKS", ({10: 8, 13: 1},))
     with S.KKTSystem(C, "pardiso") as kkt:
         kkt.factor(K)
         u, lam, rel = kkt.solve(f)
@@ -95,6 +97,35 @@ def test_a_non_finite_solve_is_redone_and_every_factorisation_counted(monkeypatc
         kkt.factor(K)
         u, _, _ = kkt.solve(f)
         assert kkt.robust and kkt.n_factor == 2 and calls[0] is False
+    assert np.abs(u - u_ref).max() <= 1e-10 * np.abs(u_ref).max()
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_fallback_that_fails_later_goes_back_to_the_defaults(monkeypatch, seed):
+    """A system on a fallback (switched to at an earlier tangent) whose next factorisation with it
+    fails its solve check tries the other variants, the defaults included, instead of refusing: the
+    fallback made unstable on purpose (:data:`UNSTABLE`; it fails, asserted first), the defaults
+    solve (SuperLU's solution to 1e-10) and stay in use.  Found on a quarter half-can's path
+    (scripts/can_half_study.py): the standard matching, once switched to, solved a later tangent to
+    a residual of 1e-2 that the defaults solve to 3e-12, and the path stopped at 0.87 N."""
+    K, C, f = _saddle(seed=seed)
+    monkeypatch.setattr(S, "_PARDISO_FALLBACKS", (UNSTABLE,))
+    with S.KKTSystem(C, "pardiso") as stuck:
+        stuck.variant = 1                                   # as after an earlier switch
+        monkeypatch.setattr(stuck, "retry_robust", lambda: False)
+        stuck.factor(K)
+        with pytest.raises(S.SolverError, match="residual"):
+            stuck.solve(f)
+    with S.KKTSystem(C, "pardiso") as kkt:
+        kkt.variant = 1
+        kkt.factor(K)
+        u, _, rel = kkt.solve(f)
+        assert not kkt.robust and kkt.n_factor == 2 and rel <= 1e-12
+        kkt.factor(K)                                       # the defaults are kept
+        assert not kkt.robust and kkt.n_factor == 3
+    with S.KKTSystem(C, "superlu") as ref:
+        ref.factor(K)
+        u_ref, _, _ = ref.solve(f)
     assert np.abs(u - u_ref).max() <= 1e-10 * np.abs(u_ref).max()
 
 
