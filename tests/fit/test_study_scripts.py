@@ -1,8 +1,9 @@
-"""The pure parts of two evidence scripts of issue 16 (scripts/ball_softening_study.py,
-scripts/duck_poke_study.py), checked against closed forms: Pogorelov-type data F = c sqrt(d) have
-local exponents 1/2 and a constant F/sqrt(d); the air's force p (-dV/dd)/2 of a linear volume law
-is exact; a sweep of a homogeneous law d0(F) = (F/k)^2 fitted by scaling gives E back; a rigid
-motion of a surface leaves no dent, a pure dent turns no ring."""
+"""The pure parts of three evidence scripts of issue 16 (scripts/ball_softening_study.py,
+scripts/duck_poke_study.py, scripts/can_half_study.py), checked against closed forms and
+invariants: Pogorelov-type data F = c sqrt(d) have local exponents 1/2 and a constant F/sqrt(d); the
+air's force p (-dV/dd)/2 of a linear volume law is exact; a sweep of a homogeneous law d0(F) =
+(F/k)^2 fitted by scaling gives E back; a rigid motion of a surface leaves no dent, a pure dent turns
+no ring; the half can's quarter model equals the whole can."""
 from __future__ import annotations
 
 import importlib.util
