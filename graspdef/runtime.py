@@ -77,3 +77,17 @@ def environment(values: dict[str, str]):
                 os.environ.pop(k, None)
             else:
                 os.environ[k] = v
+
+
+def end_process(status: int) -> None:
+    """End the process now with ``status``: flush stdout, stderr and the logging handlers, then
+    ``os._exit`` -- without Python's and the C/C++ runtime's teardown (atexit handlers, module
+    clean-up, static destructors).  For the console script after MKL PARDISO's out-of-core mode,
+    which has been seen to crash a process at exit (graspdef.cli.console); everything the run
+    writes must be closed before."""
+    import logging
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    logging.shutdown()
+    os._exit(status)

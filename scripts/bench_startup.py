@@ -1,6 +1,6 @@
 """Start-up times, old code against new, in one run (issue 17): whole processes of
 
-* ``graspdef --help`` (what the console script runs: ``from graspdef.cli import main``),
+* ``graspdef --help`` (what the console script runs: ``graspdef.cli.console``, ``main`` in trees before it),
 * ``python -c "import graspdef"``,
 * ``graspdef -q solve benchmarks/plate_ss_uniform.toml`` (the Tian & Jia plate, 40 x 40 faces:
   1,681 control vertices; reading, set-up, assembly, PARDISO solve, run folder),
@@ -46,7 +46,8 @@ PLATE = "benchmarks/plate_ss_uniform.toml"
 #: bit: tests/test_startup.py)
 SAME_RTOL = 1e-10
 #: what the ``graspdef`` console script runs
-CLI = "import sys\nfrom graspdef.cli import main\nsys.argv[0] = 'graspdef'\nsys.exit(main())"
+CLI = ("import sys\nsys.argv[0] = 'graspdef'\ntry:\n    from graspdef.cli import console\nexcept ImportError:\n"
+       "    from graspdef.cli import main\n    sys.exit(main())\nconsole()")
 
 
 def cases(out: Path) -> dict[str, list[str]]:

@@ -254,3 +254,16 @@ def test_a_negative_modulus_is_one_line_about_the_modulus(tmp_path, capsys):
     assert code == 2 and len(err) == 1, err
     assert "Young's modulus E must be a positive" in err[0] and "-2000000" in err[0], err
     assert not (tmp_path / "o").exists()
+
+
+def test_console_script_exits_with_the_commands_status(tmp_path, monkeypatch):
+    """The console script (graspdef.cli.console) exits with main's status through SystemExit (the
+    normal teardown) unless the command asked for the process to end at once (only an out-of-core
+    solve does: tests/solve/test_kkt_out_of_core.py runs that one in a process of its own): a missing
+    problem file is one line and status 2."""
+    from graspdef.cli import console
+
+    monkeypatch.setattr("sys.argv", ["graspdef", "-q", "solve", str(tmp_path / "missing.toml"), "--out", str(tmp_path / "o")])
+    with pytest.raises(SystemExit) as exc:
+        console()
+    assert exc.value.code == 2

@@ -122,6 +122,10 @@ def join_negative_values(argv: list[str]) -> list[str]:
 def main(argv: list[str] | None = None) -> int:
     """``graspdef ...``: parse, run the subcommand; a GraspdefError or OSError is one line and
     exit status 2."""
+    return _main(argv)[0]
+
+
+def _main(argv: list[str] | None) -> tuple[int, argparse.Namespace | None]:
     argv = join_negative_values(sys.argv[1:] if argv is None else list(argv))
     command = requested_command(argv)
     args = build_parser([command] if command else []).parse_args(argv)
@@ -130,11 +134,30 @@ def main(argv: list[str] | None = None) -> int:
     runtime.configure()             # before any numerical runtime starts (graspdef.runtime)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:
-        return args.func(args)
+        return args.func(args), args
     except (GraspdefError, OSError) as exc:
         print(f"graspdef: error: {exc}", file=sys.stderr)
-        return 2
+        return 2, args
+
+
+def console() -> None:
+    """The ``graspdef`` console script: :func:`main`, then the process ends with its status.
+
+    A subcommand that used PARDISO's out-of-core mode (``graspdef solve --backend pardiso-ooc``)
+    sets ``args.end_process``; the process then ends by :func:`graspdef.runtime.end_process` once its
+    output is flushed, without Python's and the C++ runtime's teardown: MKL 2026.2's out-of-core mode has been seen to
+    crash a process *at exit*, after every result was written and correct (an LLVM assertion in
+    numba's llvmlite, or a segfault; measured: 1 of 60 processes with two out-of-core solvers,
+    1 of 30 ``graspdef solve`` runs in the test suite, README "Out of core"), which turned a
+    finished run's status 0 into -6.  Everything the run writes is closed before (its files, the
+    solver's temporary folder)."""
+    rc, args = _main(None)
+    if getattr(args, "end_process", False):
+        from ..runtime import end_process
+
+        end_process(rc)
+    sys.exit(rc)
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    console()

