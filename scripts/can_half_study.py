@@ -90,9 +90,7 @@ def run_case(n_theta: int, n_z: int, t: float = T, below: float = 0.0, height: f
 
     t0 = time.perf_counter()
     pr = build(n_theta, n_z, t, below, height, bottom)
-    sp = pr.probes["A"]
-    st, w = pr.evaluator.values(sp.face, np.asarray(sp.bary))
-    lin = float(-(w @ solve_linear(pr).u.reshape(-1, 3)[st])[0])           # inward, per N per finger
+    lin = float(-solve_linear(pr).probe("A")[0])                            # inward, per N per finger
     opts = PathOptions(method="arc_length", max_load=max_force, steps=steps, targets=(F_PAPER,),
                        max_probe_displacement=max_disp, max_steps=400)
     label = f"t {t * 1e6:.0f} um, {below * 1e3:g} mm below, L {height * 1e3:g} mm, {bottom}, {n_theta}x{n_z}"

@@ -200,22 +200,19 @@ class KKTSystem:
 
     @contextlib.contextmanager
     def _ooc_environment(self):
-        """For pardiso-ooc, around every PARDISO call: MKL reads where to put its factor files and how
-        much of the factor to keep in memory from the environment (set here and restored after: no
-        lasting change to the process); and the number of MKL threads is held at the count of the
-        first out-of-core call, set locally (``mkl_set_num_threads_local``) for each call.  MKL sizes
-        its out-of-core buffers by the OpenMP thread count and requires it unchanged between the
-        analysis and the factorisation and solution phases (Intel, "How to use Intel MKL OOC
-        PARDISO"); numba's OpenMP kernels run between those phases in the same runtime (GNU OpenMP).
-        Without the fixed count, 2 of 30 and 1 of 20 runs of tests/solve/test_kkt_out_of_core.py
-        failed -- a solution off by 5e-5 at a residual of 2e-12, or a Python ``AttributeError``
-        inside pypardiso, both signs of overwritten memory -- and processes crashed at exit; with MKL
-        on one thread throughout, 0 of 60."""
-        if self._ooc_dir is None or self._solver is None:
-            with environment({"MKL_PARDISO_OOC_PATH": self._ooc_dir + os.sep,
-                              "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(self.ooc_core_mb),
-                              "MKL_PARDISO_OOC_KEEP_FILE": "0"} if self._ooc_dir is not None else {}):
-                yield
+        """For pardiso-ooc, around every PARDISO call (nothing for the in-core backends): MKL reads
+        where to put its factor files and how much of the factor to keep in memory from the
+        environment (set here and restored after: no lasting change to the process); and MKL's
+        thread count is held at that of the first out-of-core call (``MKL_Set_Num_Threads_Local``,
+        the C interface).  MKL sizes its out-of-core buffers by the OpenMP thread count and requires
+        it unchanged from the analysis to the factorisation and solution phases (Intel, "How to use
+        Intel MKL OOC PARDISO"), while numba's OpenMP kernels run between those phases in the same
+        runtime (GNU OpenMP).  Without the held count, 4 of 80 runs of
+        tests/solve/test_kkt_out_of_core.py failed -- a solution off by 5e-5 at a residual of 2e-12,
+        a Python ``AttributeError`` inside pypardiso (overwritten memory), an abort at exit -- and 1
+        of 60 processes with two out-of-core solvers aborted at exit; with it, 0 of 80 and 0 of 90."""
+        if self._ooc_dir is None:
+            yield
             return
         lib = self._solver.libmkl
         if self._ooc_threads is None:
