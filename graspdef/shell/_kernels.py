@@ -113,6 +113,35 @@ def block_positions(stencils, indptr, cols):
     return out
 
 
+@nb.njit(cache=True, parallel=True)
+def scalar_pattern(indptr, cols, sptr, idx):
+    """The scalar CSR pattern of the 3x3-block pattern (indptr, cols), written into ``sptr``
+    (3 n + 1) and ``idx`` (9 nnzb) (scalar indptr and indices, of the caller's integer type);
+    returns (base, stride): block p (row r, k-th of the L blocks of its row) holding its entry
+    (a, b) at base[p] + a stride[p] + b with base[p] = 9 indptr[r] + 3 k and stride[p] = 3 L."""
+    n = indptr.shape[0] - 1
+    nnzb = cols.shape[0]
+    sptr[0] = 0
+    for r in range(n):
+        L = indptr[r + 1] - indptr[r]
+        for a in range(3):
+            sptr[3 * r + a + 1] = 9 * indptr[r] + 3 * L * (a + 1)
+    base = np.empty(nnzb, np.int64)
+    stride = np.empty(nnzb, np.int64)
+    for r in nb.prange(n):
+        p0 = indptr[r]
+        L = indptr[r + 1] - p0
+        for k in range(L):
+            p = p0 + k
+            base[p] = 9 * p0 + 3 * k
+            stride[p] = 3 * L
+            for a in range(3):
+                q = 9 * p0 + 3 * L * a + 3 * k
+                for b in range(3):
+                    idx[q + b] = 3 * cols[p] + b
+    return base, stride
+
+
 # ------------------------------------------------------------------------------------------------
 # fused kernels of the energy, gradient and Hessian (energy.ShellEnergy); numpy reference path:
 # ShellEnergy._local with kinematics.strains / strain_jacobian / strain_hessian_contract
@@ -280,10 +309,10 @@ def _point_geometric(y, sig, n, j, Hy, A1, A2, Hm, M, M2, PA):
 
 @nb.njit(cache=True, parallel=True, fastmath=False)
 def assemble_elements(y, w, dW, ddW, D, Dt, dstride, stencils, order, bstart, cblocks, cstart,
-                      index, grad, bdata, hess):
+                      index, base, stride, grad, bdata, hess):
     """Gradient and (if ``hess``) Hessian of sum_q w_q W(s(y_q)) of every face, added in place
-    into ``grad`` (n, 3) and ``bdata`` (9 nnzb): the 3x3 blocks of a :class:`~energy.BlockPattern`,
-    block p's entry (a, b) at 9 p + 3 a + b (``BlockPattern`` positions them in its scalar CSR).
+    into ``grad`` (n, 3) and ``bdata`` (9 nnzb): the data of the scalar CSR matrix of a
+    :class:`~energy.BlockPattern`, block p's entry (a, b) at base[p] + a stride[p] + b.
 
     y : (nf, nq, 5, 3) surface derivatives; w : (nf, nq) weights; dW (nf, nq, 6), ddW
     (nf, nq, 6, 6) derivatives of the density; D : (nf|1, nq, S, 5) and Dt = D transposed to
@@ -457,29 +486,26 @@ def assemble_elements(y, w, dW, ddW, D, Dt, dstride, stencils, order, bstart, cb
                 base_f = f * S * S
                 for s in range(S):
                     # diagonal block symmetrised; off-diagonal block (s, t) and its transpose (t, s)
-                    pu = np.uint64(9 * index[base_f + s * S + s])
+                    p = index[base_f + s * S + s]
+                    pu = np.uint64(base[p])
+                    su = np.uint64(stride[p])
                     for a in range(3):
                         for b in range(3):
-                            bdata[pu + np.uint64(3 * a + b)] += 0.5 * (
+                            bdata[pu + np.uint64(a) * su + np.uint64(b)] += 0.5 * (
                                 out[np.uint64(((s * 3 + a) * 3 + b) * S4 + s)]
                                 + out[np.uint64(((s * 3 + b) * 3 + a) * S4 + s)])
                     for t in range(s + 1, S):
-                        pu = np.uint64(9 * index[base_f + s * S + t])
-                        ptu = np.uint64(9 * index[base_f + t * S + s])
+                        p = index[base_f + s * S + t]
+                        pt = index[base_f + t * S + s]
+                        pu = np.uint64(base[p])
+                        su = np.uint64(stride[p])
+                        ptu = np.uint64(base[pt])
+                        stu = np.uint64(stride[pt])
                         for a in range(3):
                             for b in range(3):
                                 v = out[np.uint64(((s * 3 + a) * 3 + b) * S4 + t)]
-                                bdata[pu + np.uint64(3 * a + b)] += v
-                                bdata[ptu + np.uint64(3 * b + a)] += v
-
-
-@nb.njit(cache=True, parallel=True)
-def gather(src, idx):
-    """src[idx] (1-D), in parallel."""
-    out = np.empty(idx.shape[0])
-    for k in nb.prange(idx.shape[0]):
-        out[k] = src[idx[k]]
-    return out
+                                bdata[pu + np.uint64(a) * su + np.uint64(b)] += v
+                                bdata[ptu + np.uint64(b) * stu + np.uint64(a)] += v
 
 
 # ------------------------------------------------------------------------------------------------

@@ -25,9 +25,9 @@ import scipy.sparse as sp
 from ._kernels import (
     assemble_elements,
     block_positions,
-    gather,
     material_hessian_blocks,
     point_strains,
+    scalar_pattern,
     scatter_blocks,
 )
 from .kinematics import strain_hessian_contract, strain_jacobian, strains
@@ -119,23 +119,13 @@ class BlockPattern:
         self.n = n
         self.nnzb = len(self.cols)
         # scalar CSR of the 3x3-block pattern: block p (row r, k-th in its row, L blocks in the
-        # row) holds entry (a, b) at  9 indptr[r] + 3 L a + 3 k + b
-        row_len = np.diff(self.indptr)
-        rowof = np.repeat(np.arange(n), row_len)
-        k_in_row = np.arange(self.nnzb) - self.indptr[rowof]
-        self.base = 9 * self.indptr[rowof] + 3 * k_in_row
-        self.stride = 3 * row_len[rowof]
-        self.scalar_indptr = np.concatenate([[0], np.cumsum(np.repeat(3 * row_len, 3))]).astype(np.int64)
-        cols3 = (3 * self.cols[:, None] + np.arange(3)).reshape(-1)          # per block row, 3L columns
-        idx = np.empty(9 * self.nnzb, np.int64)
-        for a in range(3):
-            pos = (self.base[:, None] + a * self.stride[:, None] + np.arange(3)).ravel()
-            idx[pos] = cols3
+        # row) holds entry (a, b) at  9 indptr[r] + 3 L a + 3 k + b  (_kernels.scalar_pattern)
         # index arrays in the dtype scipy keeps (int32 when it fits), so that every CSR matrix on
         # this pattern shares them: sums on the same pattern are then cheap (see solve.equilibrium)
         itype = np.int32 if 9 * self.nnzb < 2 ** 31 else np.int64
-        self.scalar_indices = idx.astype(itype)
-        self.scalar_indptr = self.scalar_indptr.astype(itype)
+        self.scalar_indptr = np.empty(3 * n + 1, itype)
+        self.scalar_indices = np.empty(9 * self.nnzb, itype)
+        self.base, self.stride = scalar_pattern(self.indptr, self.cols, self.scalar_indptr, self.scalar_indices)
 
     def assemble(self, group_blocks: list[list[tuple[np.ndarray, np.ndarray]]]) -> sp.csr_matrix:
         """Sum element blocks into a CSR matrix; ``group_blocks[g]`` lists (face_slice, blocks
@@ -162,7 +152,6 @@ class ShellEnergy:
         self.shell = shell
         self._pattern: BlockPattern | None = None
         self._gdata: list[_GroupData] | None = None
-        self._to_csr: np.ndarray | None = None
 
     @property
     def pattern(self) -> BlockPattern:
@@ -234,6 +223,7 @@ class ShellEnergy:
         pat = self.pattern if hess else None
         bdata = np.zeros(9 * pat.nnzb) if hess else np.zeros(1)
         empty = np.zeros(1, np.int64)
+        base, stride = (pat.base, pat.stride) if hess else (empty, empty)
         for gi, (gd, r, y, W, dW, ddW) in enumerate(self._points(x, 2 if hess else 1)):
             E += (r.weights * W).sum()
             dW = np.ascontiguousarray(dW, dtype=float)
@@ -241,19 +231,12 @@ class ShellEnergy:
             sc = gd.schedule
             assemble_elements(y, np.ascontiguousarray(r.weights, dtype=float), dW, ddW, gd.D, gd.Dt,
                               gd.dstride, gd.stencils, sc.order, sc.bstart, sc.cblocks, sc.cstart,
-                              pat.maps[gi] if hess else empty, grad, bdata, hess)
+                              pat.maps[gi] if hess else empty, base, stride, grad, bdata, hess)
         return float(E), grad, bdata
 
-    def _csr(self, bdata: np.ndarray) -> sp.csr_matrix:
-        """CSR matrix of the pattern from its blocks (block p's entry (a, b) at 9 p + 3 a + b)."""
+    def _csr(self, data: np.ndarray) -> sp.csr_matrix:
+        """The pattern's CSR matrix with ``data`` (already in CSR order: see ``assemble_elements``)."""
         p = self.pattern
-        if self._to_csr is None:
-            pos = (p.base[:, None, None] + np.arange(3)[:, None] * p.stride[:, None, None]
-                   + np.arange(3)).ravel()                    # CSR position of (p, a, b)
-            inv = np.empty(len(pos), np.int32 if len(pos) < 2 ** 31 else np.int64)
-            inv[pos] = np.arange(len(pos))
-            self._to_csr = inv
-        data = gather(bdata, self._to_csr)
         return sp.csr_matrix((data, p.scalar_indices, p.scalar_indptr), shape=(3 * p.n, 3 * p.n))
 
     def energy(self, x: np.ndarray) -> float:

@@ -1,4 +1,4 @@
-"""Compiled kernels of the sparse solver (numba): the pattern of the KKT matrix's upper triangle."""
+"""Compiled kernels of the sparse solver (numba): the pattern of the KKT matrix's upper triangle and its values."""
 from __future__ import annotations
 
 import numba as nb
@@ -45,3 +45,20 @@ def kkt_upper_pattern(k_indptr, k_indices, ct_indptr, ct_indices, n, m):
         indices[indptr[n + j]] = n + j
         src[indptr[n + j]] = zero
     return indptr, indices, src
+
+
+@nb.njit(cache=True, parallel=True)
+def kkt_upper_values(src, k_data, ct_data, scale):
+    """The values of :func:`kkt_upper_pattern`'s entries: K.data[src] where src >= 0,
+    ``scale`` C^T.data[-1 - src] where it points into C^T, 0 on the constraint block's diagonal."""
+    nct = ct_data.shape[0]
+    out = np.empty(src.shape[0])
+    for q in nb.prange(src.shape[0]):
+        s = src[q]
+        if s >= 0:
+            out[q] = k_data[s]
+        elif s >= -nct:
+            out[q] = scale * ct_data[-1 - s]
+        else:
+            out[q] = 0.0
+    return out

@@ -114,16 +114,10 @@ class _UpperMap:
         Ct = C.T.tocsr()
         Ct.sort_indices()
         self.shape = (n + m, n + m)
-        self.U_indptr, self.U_indices, src = kkt_upper_pattern(
+        self.U_indptr, self.U_indices, self.src = kkt_upper_pattern(
             K.indptr.astype(np.int64, copy=False), K.indices.astype(np.int64, copy=False),
             Ct.indptr.astype(np.int64, copy=False), Ct.indices.astype(np.int64, copy=False), n, m)
-        is_k = src >= 0
-        self.pos_k = np.flatnonzero(is_k)
-        self.src_k = src[is_k]                                   # K.data index of each upper entry
-        c = np.flatnonzero((src < 0) & (src > -(Ct.nnz + 1)))
-        keep = Ct.data[-1 - src[c]] != 0
-        self.pos_c = c[keep]
-        self.c_data = Ct.data[-1 - src[self.pos_c]]
+        self.ct_data = np.asarray(Ct.data, float)
 
     def matches(self, K: sp.csr_matrix) -> bool:
         return (same_array(K.indptr, self.indptr) and same_array(K.indices, self.indices)) or (
@@ -131,9 +125,9 @@ class _UpperMap:
             and np.array_equal(K.indices, self.indices))
 
     def upper(self, K: sp.csr_matrix, scale: float) -> sp.csr_matrix:
-        data = np.zeros(self.U_indices.size)
-        data[self.pos_k] = K.data[self.src_k]
-        data[self.pos_c] = scale * self.c_data
+        from graspdef.solve._kernels import kkt_upper_values
+
+        data = kkt_upper_values(self.src, np.asarray(K.data, float), self.ct_data, float(scale))
         return sp.csr_matrix((data, self.U_indices, self.U_indptr), shape=self.shape)
 
 
