@@ -1,5 +1,6 @@
-"""Compiled distance kernels of the fingertip obstacles (numba), for the many evaluations of the
-condensed finger advance over thousands of samples.  Pure functions of arrays; the numpy methods
+"""Compiled kernels of the contact terms (numba): the distance functions of the fingertip
+obstacles, for the many evaluations of the condensed finger advance over thousands of samples,
+and the sample operator's gathers and scatters (graspdef.contact.sampling.SampleOperator).  Pure functions of arrays; the numpy methods
 of graspdef.contact.obstacles compute the same quantities and tests/contact compares the two.
 
 Each takes the points P (k, 3) and a shift (3,) subtracted from every point (the obstacle's
@@ -89,3 +90,89 @@ def capsule_distance(P, shift, a, b, radius, e):
         d1[i] = -ne
         d2[i] = (ee - ne * ne - (ue * ue if (t > 0.0 and t < 1.0) else 0.0)) / r
     return phi, n, d1, d2
+
+
+# ------------------------------------------------------------------------------------------------
+# the sample operator S (graspdef.contact.sampling.SampleOperator): rows of a CSR matrix (ptr,
+# cols, vals), each sample point p_k = sum_j vals[j] x[cols[j]] over its row's entries
+@nb.njit(cache=True)
+def sample_rows_points(ptr, cols, vals, x, rows):
+    """The points (k, 3) of the sample ``rows`` (k,) at control points x (n, 3)."""
+    k = rows.shape[0]
+    out = np.zeros((k, 3))
+    for i in range(k):
+        r = rows[i]
+        for j in range(ptr[r], ptr[r + 1]):
+            c = cols[j]
+            w = vals[j]
+            out[i, 0] += w * x[c, 0]
+            out[i, 1] += w * x[c, 1]
+            out[i, 2] += w * x[c, 2]
+    return out
+
+
+@nb.njit(cache=True)
+def sample_rows_gradient(ptr, cols, vals, g, rows, n):
+    """S[rows]^T g for per-sample vectors g (k, 3): the control points' (n, 3), flattened."""
+    out = np.zeros(3 * n)
+    for i in range(rows.shape[0]):
+        r = rows[i]
+        for j in range(ptr[r], ptr[r + 1]):
+            c = 3 * cols[j]
+            w = vals[j]
+            out[c] += w * g[i, 0]
+            out[c + 1] += w * g[i, 1]
+            out[c + 2] += w * g[i, 2]
+    return out
+
+
+@nb.njit(cache=True)
+def sample_pair_positions(ptr, cols, indptr, bcols):
+    """For every row of S, the block positions in the block pattern (indptr, bcols; sorted
+    columns) of each pair (cols[i], cols[j]) of its entries, row by row in (i, j) order: (pptr,
+    pos) with row r's pairs at pos[pptr[r]:pptr[r + 1]]; -1 where a pair is not in the pattern."""
+    nr = ptr.shape[0] - 1
+    pptr = np.empty(nr + 1, np.int64)
+    pptr[0] = 0
+    for r in range(nr):
+        m = ptr[r + 1] - ptr[r]
+        pptr[r + 1] = pptr[r] + m * m
+    pos = np.empty(pptr[nr], np.int64)
+    for r in range(nr):
+        q = pptr[r]
+        for i in range(ptr[r], ptr[r + 1]):
+            a = cols[i]
+            for j in range(ptr[r], ptr[r + 1]):
+                c = cols[j]
+                lo, hi = indptr[a], indptr[a + 1]
+                while lo < hi:
+                    mid = (lo + hi) // 2
+                    if bcols[mid] < c:
+                        lo = mid + 1
+                    else:
+                        hi = mid
+                pos[q] = lo if (lo < indptr[a + 1] and bcols[lo] == c) else -1
+                q += 1
+    return pptr, pos
+
+
+@nb.njit(cache=True)
+def sample_rows_hessian(ptr, vals, pptr, pos, base, stride, H, rows, out):
+    """Add sum_k (S_k x I3)^T H_k (S_k x I3) for the sample ``rows`` (k,) with 3 x 3 blocks H
+    (k, 3, 3) into ``out``, the data of the pattern's scalar CSR matrix (block p's entry (a, b)
+    at base[p] + a stride[p] + b; see graspdef.shell._kernels.scalar_pattern)."""
+    for i in range(rows.shape[0]):
+        r = rows[i]
+        j0 = ptr[r]
+        m = ptr[r + 1] - j0
+        q = pptr[r]
+        for ii in range(m):
+            wi = vals[j0 + ii]
+            for jj in range(m):
+                c = wi * vals[j0 + jj]
+                p = pos[q + ii * m + jj]
+                o = base[p]
+                st = stride[p]
+                for a in range(3):
+                    for b in range(3):
+                        out[o + a * st + b] += c * H[i, a, b]

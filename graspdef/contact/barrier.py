@@ -147,7 +147,7 @@ class FingerContact(TermBase):
         faces, L = select_faces(shell, self._obs, self._e, self.reach, self.depth, self.spacing, self.name)
         self._st, self._N, self._w = sample_faces(shell, ev, faces, L)
         self._faces, self._L, self._n = faces, L, shell.n_control
-        self._ops = SampleOperator(self._st, self._N, shell.n_control)
+        self._ops = SampleOperator(self._st, self._N, shell.n_control, shell.block_pattern)
         self._kw = self._kappa * self._w.ravel()                 # barrier weight per sample
         self._shell, self._ev = shell, ev
         x_s = self._points(X)

@@ -59,11 +59,22 @@ class ForceControlledAdvance:
             return (g - F if ok else np.inf), gs, ok
 
         def dmin(t):
+            """A lower bound of the smallest gap at t: within the window, the window's smallest
+            gap or, if smaller, dhat + W - |t - s_c| (the least gap a sample outside it can have
+            there: it had d >= dhat + W at s_c); elsewhere the smallest gap of all samples."""
+            off = abs(t - sel["c"])
+            if off < W:
+                bound = self._dh + W - off
+                if len(sel["p"]):
+                    bound = min(bound, float(self._obs.along(sel["p"], t * self._e, self._e)[0].min()))
+                return bound
             return float(self._obs.along(P, t * self._e, self._e)[0].min())
 
         def bracket(s):
-            """(lo, hi): G(lo) < 0 <= G(hi); advancing conservatively (never by more than 0.9 of
-            the smallest gap, so the fingertip cannot jump over a sample)."""
+            """(lo, hi, start): G(lo) < 0 <= G(hi); advancing conservatively (never by more than 0.9
+            of the smallest gap, so the fingertip cannot jump over a sample); ``start`` is the end
+            found last, the one nearer s (where Newton starts: s is the last solution, usually
+            close to the new one)."""
             window(s)
             Gs = G(s)[0]
             step = self._dh
@@ -73,14 +84,14 @@ class ForceControlledAdvance:
                     dm = dmin(lo)
                     t = lo + min(step, 0.9 * dm)
                     if G(t)[0] >= 0:
-                        return lo, t
+                        return lo, t, lo
                     lo, step = t, 2 * step
             else:
                 hi = s
                 for _ in range(60):
                     t = hi - step
                     if G(t)[0] < 0:
-                        return t, hi
+                        return t, hi, hi
                     hi, step = t, 2 * step
             return None
 
@@ -88,8 +99,7 @@ class ForceControlledAdvance:
         if br is None:
             raise NoPosition(f"finger contact '{self.name}': no finger position balances {F:.6g} N "
                              "(a shell point is behind the fingertip)")
-        lo, hi = br
-        s = lo
+        lo, hi, s = br
         Gs, gs, ok = G(s)
         for _ in range(200):                                    # safeguarded Newton
             if abs(Gs) <= 1e-12 * F or hi - lo <= 1e-15 * max(abs(lo), self._dh):

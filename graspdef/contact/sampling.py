@@ -84,29 +84,67 @@ class SampleOperator:
 
     A term with per-sample values gathers its points with :meth:`points` and scatters its per-sample
     gradients (k, 3) and 3 x 3 Hessian blocks (k, 3, 3) of a subset of rows back to the control
-    points with :meth:`gradient` and :meth:`hessian` (S^T g and (S (x) I3)^T H (S (x) I3))."""
+    points with :meth:`gradient` and :meth:`hessian` (S^T g and (S (x) I3)^T H (S (x) I3)), by
+    compiled loops over the rows (graspdef.contact._kernels).  With the shell's block ``pattern``
+    (graspdef.shell.energy.BlockPattern; a sample's stencil is its face's, so every pair of it is
+    in the pattern), :meth:`hessian` returns a matrix on the pattern's own index arrays: the sum
+    with the shell's Hessian is then entry by entry and the tangent keeps one sparsity pattern."""
 
-    def __init__(self, stencils: np.ndarray, N: np.ndarray, n_control: int):
+    def __init__(self, stencils: np.ndarray, N: np.ndarray, n_control: int, pattern=None):
+        from ._kernels import sample_pair_positions
+
         F, q, S = N.shape
         rows = np.repeat(np.arange(F * q), S)
         cols = np.broadcast_to(stencils[:, None, :], (F, q, S)).ravel()
         M = sp.csr_matrix((N.ravel(), (rows, cols)), shape=(F * q, n_control))
         M.eliminate_zeros()                              # the stencils' zero-weight padding
+        M.sort_indices()
         self.S, self.n = M, n_control
+        self._ptr = M.indptr.astype(np.int64)
+        self._cols = M.indices.astype(np.int64)
+        self._vals = np.ascontiguousarray(M.data, dtype=float)
+        self._pattern = None
+        self._last = None            # (x, S x) of the last call of points(x): the terms ask for it repeatedly
+        if pattern is not None:
+            pptr, pos = sample_pair_positions(self._ptr, self._cols, pattern.indptr, pattern.cols)
+            if pos.size and pos.min() >= 0:
+                self._pattern, self._pptr, self._pos = pattern, pptr, pos
 
     def points(self, x: np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
         """Sample points (Q, 3) of control points x (n, 3), or of ``rows`` only (k, 3)."""
-        return (self.S if rows is None else self.S[rows]) @ x
+        if rows is None:
+            last = self._last
+            if last is not None and last[0].shape == np.shape(x) and np.array_equal(last[0], x):
+                return last[1].copy()
+            P = self.S @ x
+            self._last = (np.array(x, dtype=float), P.copy())
+            return P
+        from ._kernels import sample_rows_points
+
+        return sample_rows_points(self._ptr, self._cols, self._vals, np.ascontiguousarray(x, dtype=float),
+                                  np.asarray(rows, np.int64))
 
     def gradient(self, g: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """Per-sample gradients g (k, 3) of ``rows`` (k,) scattered to the control points: (3 n,)."""
-        return np.asarray(self.S[rows].T @ g).ravel()
+        from ._kernels import sample_rows_gradient
+
+        return sample_rows_gradient(self._ptr, self._cols, self._vals, np.ascontiguousarray(g, dtype=float),
+                                    np.asarray(rows, np.int64), self.n)
 
     def hessian(self, H: np.ndarray, rows: np.ndarray) -> sp.csr_matrix:
         """Per-sample 3 x 3 Hessian blocks H (k, 3, 3) of ``rows`` (k,) assembled over the control
         points: the (3 n, 3 n) matrix sum_k (S_k (x) I3)^T H_k (S_k (x) I3)."""
         k = len(rows)
         n3 = 3 * self.n
+        pat = self._pattern
+        if pat is not None:
+            from ._kernels import sample_rows_hessian
+
+            data = np.zeros(pat.scalar_indices.size)
+            if k:
+                sample_rows_hessian(self._ptr, self._vals, self._pptr, self._pos, pat.base, pat.stride,
+                                    np.ascontiguousarray(H, dtype=float), np.asarray(rows, np.int64), data)
+            return sp.csr_matrix((data, pat.scalar_indices, pat.scalar_indptr), shape=(n3, n3))
         if k == 0:
             return sp.csr_matrix((n3, n3))
         S3 = sp.kron(self.S[rows], sp.identity(3, format="csr"), format="csr")

@@ -36,7 +36,12 @@ from .sparse import KKTSystem, same_array
 
 def _add(A: sp.spmatrix, B: sp.spmatrix) -> sp.csr_matrix:
     """A + B (a new matrix: the terms may hand out cached matrices); entry by entry when both
-    are CSR on the same index arrays (the shell's shared pattern) or an equal structure."""
+    are CSR on the same index arrays (the shell's shared pattern) or an equal structure; a matrix
+    with no stored entries (a term that is zero, e.g. friction with mu = 0) leaves the other's
+    structure as it is (scipy's sum would drop its explicit zeros)."""
+    if B.nnz == 0 or A.nnz == 0:
+        C = (A if B.nnz == 0 else B).tocsr()
+        return sp.csr_matrix((C.data.copy(), C.indices, C.indptr), shape=C.shape)
     if sp.isspmatrix_csr(A) and sp.isspmatrix_csr(B) and (
             (same_array(A.indices, B.indices) and same_array(A.indptr, B.indptr))
             or (A.nnz == B.nnz and A.has_sorted_indices and B.has_sorted_indices

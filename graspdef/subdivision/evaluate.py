@@ -105,8 +105,16 @@ def _chart_steps(N: np.ndarray, dN: np.ndarray, X: np.ndarray, p: np.ndarray) ->
     A = np.einsum("msk,msd->mkd", dN, X)                     # (m, 2, 3): a1, a2
     M = np.einsum("mkd,mld->mkl", A, A)
     b = -np.einsum("mkd,md->mk", A, r)
+    # 2 x 2 normal equations, by Cramer's rule where M is well conditioned (det above 1e-12 of
+    # its trace squared: condition number below ~1e12), least squares (np.linalg.lstsq) elsewhere
+    det = M[:, 0, 0] * M[:, 1, 1] - M[:, 0, 1] * M[:, 1, 0]
+    tr = M[:, 0, 0] + M[:, 1, 1]
+    good = det > 1e-12 * tr * tr
     out = np.empty_like(b)
-    for i in range(len(b)):                                  # 2 x 2 least squares (as np.linalg.lstsq)
+    dg = np.where(good, det, 1.0)
+    out[:, 0] = (M[:, 1, 1] * b[:, 0] - M[:, 0, 1] * b[:, 1]) / dg
+    out[:, 1] = (M[:, 0, 0] * b[:, 1] - M[:, 1, 0] * b[:, 0]) / dg
+    for i in np.flatnonzero(~good):
         out[i] = np.linalg.lstsq(M[i], b[i], rcond=None)[0]
     return out
 

@@ -203,3 +203,25 @@ def test_sample_operator_gathers_and_scatters_like_the_stencils(shell):
     H = ops.hessian(Hk, rows)
     assert H.shape == (3 * shell.n_control,) * 2 and abs(H - H.T).max() < 1e-12 * abs(H).max()
     assert np.isclose(v.ravel() @ (H @ v.ravel()), np.einsum("ki,kij,kj->", Sv, Hk, Sv), rtol=1e-12)
+
+
+def test_sample_operator_on_the_shell_pattern_equals_the_general_one(shell):
+    """With the shell's block pattern the Hessian is assembled on the pattern's own index arrays
+    (so that it sums with the shell's Hessian entry by entry): the same matrix as the general
+    sparse product (S3^T H S3) to round-off, every sample pair found in the pattern."""
+    from graspdef.contact.sampling import SampleOperator, sample_faces
+    from graspdef.solve.sparse import same_array
+
+    st, N, _ = sample_faces(shell, shell.evaluator, np.arange(0, 60, 3), 3)
+    pat = shell.block_pattern
+    ops = SampleOperator(st, N, shell.n_control, pat)
+    gen = SampleOperator(st, N, shell.n_control)
+    assert ops._pattern is pat and gen._pattern is None
+    rng = np.random.default_rng(5)
+    rows = np.sort(rng.choice(ops.S.shape[0], 50, replace=False))
+    Hk = rng.normal(size=(50, 3, 3))
+    H = ops.hessian(Hk, rows)
+    assert same_array(H.indices, pat.scalar_indices) and same_array(H.indptr, pat.scalar_indptr)
+    D = (H - gen.hessian(Hk, rows)).toarray()
+    assert abs(D).max() <= 1e-14 * abs(H).max()
+    assert ops.hessian(Hk[:0], rows[:0]).nnz == pat.scalar_indices.size and not ops.hessian(Hk[:0], rows[:0]).data.any()
