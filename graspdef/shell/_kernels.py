@@ -113,7 +113,7 @@ def block_positions(stencils, indptr, cols):
     return out
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True)
 def scalar_pattern(indptr, cols, sptr, idx):
     """The scalar CSR pattern of the 3x3-block pattern (indptr, cols), written into ``sptr``
     (3 n + 1) and ``idx`` (9 nnzb) (scalar indptr and indices, of the caller's integer type);
@@ -128,7 +128,7 @@ def scalar_pattern(indptr, cols, sptr, idx):
             sptr[3 * r + a + 1] = 9 * indptr[r] + 3 * L * (a + 1)
     base = np.empty(nnzb, np.int64)
     stride = np.empty(nnzb, np.int64)
-    for r in nb.prange(n):
+    for r in range(n):
         p0 = indptr[r]
         L = indptr[r + 1] - p0
         for k in range(L):

@@ -47,13 +47,13 @@ def kkt_upper_pattern(k_indptr, k_indices, ct_indptr, ct_indices, n, m):
     return indptr, indices, src
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True)
 def kkt_upper_values(src, k_data, ct_data, scale):
     """The values of :func:`kkt_upper_pattern`'s entries: K.data[src] where src >= 0,
     ``scale`` C^T.data[-1 - src] where it points into C^T, 0 on the constraint block's diagonal."""
     nct = ct_data.shape[0]
     out = np.empty(src.shape[0])
-    for q in nb.prange(src.shape[0]):
+    for q in range(src.shape[0]):
         s = src[q]
         if s >= 0:
             out[q] = k_data[s]
