@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from graspdef.contact.barrier import Capsule, FingerContact, RoundedBox, log_barrier
+from graspdef.errors import ProblemError
 from graspdef.geometry import icosphere
 from graspdef.problem.loads import PointLoad
 from graspdef.problem.problem import Problem
@@ -177,6 +178,24 @@ def test_small_pin_matches_point_loads_away_from_contact(shell):
     ring = [band & (np.sign(X[:, 0]) == s) for s in (1, -1)]
     ac, ap = (u[ring[0], 0].mean() - u[ring[1], 0].mean() for u in (uc, up))
     assert ap < 0 and ac == pytest.approx(ap, rel=0.15)
+
+
+def test_the_linear_predictor_reaches_the_same_equilibria(shell):
+    """PathOptions(predictor="linear"), the finger-contact paths' setting (barrier.CONTACT_PATH):
+    only the first iterate of each step changes, so every path point is the same equilibrium as
+    with the default quadratic predictor -- the pads' squeeze above at 0.25, 0.5 and 1 of the force
+    to the Newton tolerance (1e-8 of the force scale: the displacements to ~1e-7 of the largest)."""
+    F = 0.5
+    fingers = [FingerContact(_pad(+1), (-1.0, 0, 0), F, offset=T / 2, name="right"),
+               FingerContact(_pad(-1), (1.0, 0, 0), F, offset=T / 2, name="left")]
+    pr = Problem(shell, list(fingers), [RigidModes()])
+    sols = [solve_nonlinear(pr, PathOptions(steps=4, targets=(0.25, 0.5), predictor=p)) for p in ("quadratic", "linear")]
+    assert all(s.completed for s in sols)
+    for lam in (0.25, 0.5, 1.0):
+        a, b = (s.at(lam).u for s in sols)
+        assert np.abs(a - b).max() <= 1e-6 * np.abs(a).max()
+    with pytest.raises(ProblemError, match="predictor must be one of quadratic, linear"):
+        PathOptions(predictor="cubic")
 
 
 def test_sample_operator_gathers_and_scatters_like_the_stencils(shell):
