@@ -84,7 +84,11 @@ def roundoff_floor(H: sp.csr_matrix, x: np.ndarray) -> float:
     if H is None:
         return 0.0
     x = np.asarray(x, float).ravel()
-    H2 = H.multiply(H)
+    H = H.tocsr()
+    if not H.has_canonical_format:                 # entry-wise squares need each entry once
+        H = H.copy()
+        H.sum_duplicates()
+    H2 = sp.csr_matrix((H.data * H.data, H.indices, H.indptr), shape=H.shape)    # H o H on H's structure
     return float(ROUNDOFF_FACTOR * np.finfo(float).eps * np.linalg.norm(np.sqrt(H2 @ (x * x))))
 
 
