@@ -10,6 +10,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from ..shell._kernels import sorted_search
+
 
 @nb.njit(cache=True, fastmath=False)
 def box_distance(P, shift, c, R, h, rounding, e):
@@ -144,13 +146,7 @@ def sample_pair_positions(ptr, cols, indptr, bcols):
             a = cols[i]
             for j in range(ptr[r], ptr[r + 1]):
                 c = cols[j]
-                lo, hi = indptr[a], indptr[a + 1]
-                while lo < hi:
-                    mid = (lo + hi) // 2
-                    if bcols[mid] < c:
-                        lo = mid + 1
-                    else:
-                        hi = mid
+                lo = sorted_search(bcols, indptr[a], indptr[a + 1], c)
                 pos[q] = lo if (lo < indptr[a + 1] and bcols[lo] == c) else -1
                 q += 1
     return pptr, pos

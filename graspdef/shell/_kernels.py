@@ -90,6 +90,18 @@ def scatter_blocks(data, index, blocks, base, stride):
                 k += 1
 
 
+@nb.njit(cache=True)
+def sorted_search(cols, lo, hi, c):
+    """The first position in cols[lo:hi] (sorted) whose value is not below c (hi if none)."""
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if cols[mid] < c:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
 @nb.njit(cache=True, parallel=True)
 def block_positions(stencils, indptr, cols):
     """Position in the block-CSR pattern (indptr, cols; sorted columns) of every stencil pair
@@ -101,15 +113,7 @@ def block_positions(stencils, indptr, cols):
             r = stencils[f, s]
             lo0, hi0 = indptr[r], indptr[r + 1]
             for t in range(S):
-                c = stencils[f, t]
-                lo, hi = lo0, hi0
-                while lo < hi:
-                    mid = (lo + hi) // 2
-                    if cols[mid] < c:
-                        lo = mid + 1
-                    else:
-                        hi = mid
-                out[(f * S + s) * S + t] = lo
+                out[(f * S + s) * S + t] = sorted_search(cols, lo0, hi0, stencils[f, t])
     return out
 
 
