@@ -101,9 +101,9 @@ class PathOptions:
         step -- the Newton system at the iterate solved by GMRES preconditioned by the reused
         factorisation (tangent products by gradient differences) to krylov_rtol times its residual --
         and factorise only when GMRES needs more than ``krylov`` iterations (e.g. 10; 0, the
-        default: always factorise, the behaviour before -- the inexact steps pay on the 10k-vertex
-        ball, 22 -> 12 factorisations, but not on the slit annular plate: 87 steps and 229
-        factorisations instead of 41-50 and 210-235); see :meth:`PathSolver.newton`
+        default: always factorise -- the inexact steps pay on the 10k-vertex air-filled ball, 22 ->
+        12 factorisations, but not on the slit annular plate nor on the 18,624-vertex pinched
+        cylinder, 229 -> 261 factorisations); see :meth:`PathSolver.newton`
     inertia_rtol : the stability of a point is the inertia of a Hessian factorised within this
         relative residual of it (0: at the converged state itself); see :meth:`PathSolver.newton`
     bifurcation : what a load-controlled path does at a change of stability that is not a limit
@@ -407,8 +407,12 @@ class PathSolver:
         ``inertia_rtol`` -- where the tangent is factorised as above, for the stability -- or
         GMRES needs more than ``krylov`` iterations or a step to ``krylov_rtol`` does not contract
         by ``reuse_ratio`` (a looser one that does not is first retried to ``krylov_rtol``): then
-        the tangent is factorised there, as without them.  An inexact step never gives a
-        stability: that comes only from factorisations, as above."""
+        the tangent is factorised there, as without them.  Once a step on a tangent factorised at
+        its own iterate has not contracted by ``reuse_ratio`` (Newton is still far from the
+        solution: the inexact steps would only repeat what the exact one failed to do), this solve
+        takes no more inexact steps (the 891-vertex slit annular plate with ``krylov`` 10: 34 -> 23 s;
+        the 10k ball's path unchanged).  An inexact step never gives a stability: that comes only
+        from factorisations, as above."""
         eq, opt = self.eq, self.opt
         u = u0.copy()
         first = prev = None
@@ -418,6 +422,8 @@ class PathSolver:
         near = None                 # inertia of a factorisation at an iterate within inertia_rtol
         inexact = False             # the iterations since the last factorisation are GMRES steps
         eta = None                  # forcing term of the last inexact step
+        exact = False               # the last step was on a tangent factorised at its iterate
+        far = False                 # a step on a fresh tangent did not contract: no inexact steps
         self.last_step = np.inf
 
         def refresh(u, st, cres, tight=False, keep_near=False):
@@ -426,7 +432,7 @@ class PathSolver:
             factorisation (which gives the stability if within inertia_rtol, unless ``keep_near``:
             the line search's refresh, which never did); returns (state, du, exact)."""
             nonlocal near, hist, inexact, eta
-            if opt.krylov and near is None:
+            if opt.krylov and near is None and not far:
                 # forcing term (Eisenstat & Walker 1996, choice 2): loose while Newton itself
                 # contracts slowly, down to krylov_rtol as it reaches its quadratic rate
                 e = KRYLOV_ETA_MAX if prev is None else 0.9 * (rel / prev) ** 2
@@ -471,6 +477,8 @@ class PathSolver:
             if it >= 8 and rel > 10 * first and not patient:
                 raise _Failed(f"Newton diverges at load factor {lam:.6g} (residual {rel:.2e})")
             poor = prev is not None and rel > opt.reuse_ratio * prev
+            if exact and poor:
+                far = True
             fresh = False                 # du is a step on this iterate's tangent (exact or GMRES)
             cres = eq.constraint_residual(u, lam)
             if not need_h and (near is None and rel <= opt.inertia_rtol
@@ -535,6 +543,7 @@ class PathSolver:
                       f" (Anderson {len(hist) - 1})" if len(hist) > 1 else "")
             u = u + step
             prev = rel
+            exact = need_h or (fresh and not inexact)
             self.last_step = float(np.linalg.norm(step)) / max(float(np.linalg.norm(u)), 1e-300)
             need_h = not opt.reuse_factorisation
         raise _Failed(f"Newton did not converge in {max_it} iterations at load factor "
