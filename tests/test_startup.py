@@ -185,6 +185,27 @@ def test_configure_fixes_openblas_threads_unless_the_user_did():
     assert run(pre="import numpy\n") == ["1", "1", False]
 
 
+def test_configure_keeps_mujoco_from_loading_opengl_unless_the_user_chose():
+    """graspdef never renders with MuJoCo: runtime.configure sets MUJOCO_GL=disable when it is
+    unset, so that ``import mujoco`` loads no OpenGL backend (GLFW, PyOpenGL; checked in
+    sys.modules of a fresh interpreter, where without it GLFW is loaded), and keeps a user's own
+    choice (EGL loads PyOpenGL's EGL)."""
+    code = ("import json, os, sys\nfrom graspdef import runtime\n{pre}import mujoco\n"
+            "print(json.dumps([os.environ.get('MUJOCO_GL'), "
+            "sorted({{m.split('.')[0] for m in sys.modules if m.split('.')[0] in ('glfw', 'OpenGL')}})]))")
+    env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
+
+    def run(pre="runtime.configure()\n", extra=None):
+        r = subprocess.run([sys.executable, "-c", code.format(pre=pre)], capture_output=True, text=True,
+                           env=env | (extra or {}), cwd=ROOT, check=False)
+        assert r.returncode == 0, r.stderr
+        return json.loads(r.stdout.strip().splitlines()[-1])
+
+    assert run() == ["disable", []]
+    assert run(pre="") == [None, ["glfw"]]                 # what configure saves: GLFW's import
+    assert run(extra={"MUJOCO_GL": "egl"}) == ["egl", ["OpenGL"]]
+
+
 def test_a_pardiso_solver_without_configure_does_not_search_for_mkl():
     """A library user who never calls ``runtime.configure``: creating PARDISO solvers must not
     make pypardiso search sys.prefix for MKL's runtime (a recursive glob, ~1 s per solver and
