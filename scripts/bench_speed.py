@@ -14,11 +14,17 @@ Targets (issue 2): 10,000 control vertices, assembly + solve <= 2 s; 100,000 con
 <= 60 s and <= 8 GB.  Writes ``bench_speed.json`` to ``--out``.
 
     python scripts/bench_speed.py [--sizes 70 224] [--repeats 5 3] [--ref GIT_REF --rounds 3] [--backend pardiso-ooc]
-                                  [--out out/bench_speed]
+                                  [--collocation 2 1] [--out out/bench_speed]
 
 ``--ref GIT_REF``: also measure the OLD code of that git ref (a temporary worktree, scripts/_trees.py),
 OLD and NEW processes alternating ``--rounds`` times per size; the table then has a row per tree and
 the medians are over all of that tree's timed runs.
+
+``--collocation 2 1``: the supports' collocation points per edge (``Problem.n_collocation``, a problem
+file's ``[solver] collocation``; default 2), one row per value, the processes of the values alternating
+like the trees'.  The cylinder's diaphragms are closed rings, where two points per edge give nearly
+dependent rows that graspdef replaces by dense orthonormal ones (``problem.supports.well_conditioned_rows``)
+and one point per edge gives sparse, well-conditioned rows.
 """
 from __future__ import annotations
 
@@ -40,12 +46,14 @@ import json, sys, time
 n_z = int(sys.argv[1]); repeats = int(sys.argv[2])
 sys.path.insert(0, sys.argv[3])
 backend = sys.argv[4] if len(sys.argv) > 4 else "auto"
+ncol = int(sys.argv[5]) if len(sys.argv) > 5 else 2
 from convergence import pinched_cylinder_problem
 from graspdef.solve.linear import solve_linear
 runs = []
 for rep in range(repeats + 1):          # the first run warms caches (numba, imports) and is dropped
     t0 = time.perf_counter()
     pr = pinched_cylinder_problem(n_z)
+    pr.n_collocation = ncol
     t1 = time.perf_counter()
     sol = solve_linear(pr, backend=backend)
     t = sol.timings
@@ -63,10 +71,10 @@ print(json.dumps({"runs": runs, "peak_MB": peak}))
 """
 
 
-def _child(n_z: int, repeats: int, tree: Path, backend: str = "auto") -> dict:
+def _child(n_z: int, repeats: int, tree: Path, backend: str = "auto", ncol: int = 2) -> dict:
     """One fresh process of ``tree``'s code: ``repeats`` timed solves after a warm-up."""
     env = {**os.environ, "PYTHONPATH": str(tree)}
-    out = subprocess.run([sys.executable, "-c", CHILD, str(n_z), str(repeats), str(tree / "scripts"), backend],
+    out = subprocess.run([sys.executable, "-c", CHILD, str(n_z), str(repeats), str(tree / "scripts"), backend, str(ncol)],
                          capture_output=True, text=True, check=True, cwd=tree, env=env)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
@@ -91,26 +99,30 @@ def main() -> None:
     ap.add_argument("--ref", help="git ref of the OLD code to measure beside the working tree")
     ap.add_argument("--rounds", type=int, default=3, help="with --ref: OLD/NEW processes alternating per size")
     ap.add_argument("--backend", default="auto", help="sparse solver: auto, pardiso, pardiso-ooc (out of core), superlu")
+    ap.add_argument("--collocation", type=int, nargs="+", default=[2],
+                    help="collocation points per supported edge (one row per value; default 2)")
     ap.add_argument("--out", default="out/bench_speed")
     a = ap.parse_args()
     reps = a.repeats + [a.repeats[-1]] * (len(a.sizes) - len(a.repeats))
     rows = []
     with code_trees(ROOT, a.ref, prefix="bench_speed_") as trees:
         for n_z, r in zip(a.sizes, reps):
-            rounds = a.rounds if a.ref else 1
+            rounds = a.rounds if a.ref or len(a.collocation) > 1 else 1
             print(f"pinched cylinder n_z={n_z}: {rounds} x {r} timed runs per tree ({', '.join(trees)}) ...",
                   file=sys.stderr, flush=True)
-            data, t0 = {name: [] for name in trees}, time.perf_counter()
+            cases = [(name, ncol) for name in trees for ncol in a.collocation]
+            data, t0 = {c: [] for c in cases}, time.perf_counter()
             for _ in range(rounds):
-                for name, tree in trees.items():          # OLD first, then NEW, alternating
-                    data[name].append(_child(n_z, r, tree, a.backend))
-            for name in trees:
-                rows.append({"tree": name, **summarise(n_z, data[name], t0)})
-    print("| code | control vertices | dofs | set-up [s] | assembly [s] | solve [s] (factor) | assembly + solve [s] | peak memory [MB] | u_A error |")
-    print("|---|---|---|---|---|---|---|---|---|")
+                for name, ncol in cases:                  # OLD first, then NEW, alternating
+                    data[name, ncol].append(_child(n_z, r, trees[name], a.backend, ncol))
+            for name, ncol in cases:
+                label = name if a.collocation == [2] else f"{name}, collocation {ncol}"
+                rows.append({"tree": label, "collocation": ncol, **summarise(n_z, data[name, ncol], t0)})
+    print("| code | control vertices | dofs | constraints | set-up [s] | assembly [s] | solve [s] (factor) | assembly + solve [s] | peak memory [MB] | u_A error |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for x in rows:
         m = x["median"]
-        print(f"| {x['tree']} | {x['n_control']} | {x['n_dofs']} | {m['setup']:.2f} | {m['assembly']:.2f} | "
+        print(f"| {x['tree']} | {x['n_control']} | {x['n_dofs']} | {x['n_constraints']} | {m['setup']:.2f} | {m['assembly']:.2f} | "
               f"{m['solve']:.2f} ({m['factor']:.2f}) | {x['assembly_plus_solve']:.2f} | {x['peak_MB']:.0f} | "
               f"{100 * x['rel_error']:+.3f} % |")
     print(f"medians of {', '.join(str(x['repeats']) for x in rows)} timed runs (each process after one warm-up run), "
