@@ -167,18 +167,23 @@ def test_lazy_imports_change_no_number(lazy_plate, tmp_path):
     assert (out / "deformed.ply").read_bytes() == (tmp_path / "eager" / "deformed.ply").read_bytes()
 
 
+def _fresh_json(code: str, unset: str, extra: dict | None = None):
+    """Run ``code`` in a fresh interpreter with the environment variable ``unset`` removed (and
+    ``extra`` added); returns the JSON of its last printed line."""
+    env = {k: v for k, v in os.environ.items() if k != unset} | (extra or {})
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=ROOT, check=False)
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
 def test_configure_fixes_openblas_threads_unless_the_user_did():
     """graspdef.runtime.configure sets OPENBLAS_NUM_THREADS=1 when it is unset, keeps a user's
     value, and says whether it came before numpy's first import (only then does OpenBLAS read it)."""
     code = ("import json, os\nfrom graspdef import runtime\n{pre}r = runtime.configure()\n"
             "print(json.dumps([os.environ['OPENBLAS_NUM_THREADS'], r['OPENBLAS_NUM_THREADS'], r['blas_threads_fixed']]))")
-    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
 
     def run(pre="", extra=None):
-        r = subprocess.run([sys.executable, "-c", code.format(pre=pre)], capture_output=True, text=True,
-                           env=env | (extra or {}), cwd=ROOT, check=False)
-        assert r.returncode == 0, r.stderr
-        return json.loads(r.stdout.strip().splitlines()[-1])
+        return _fresh_json(code.format(pre=pre), "OPENBLAS_NUM_THREADS", extra)
 
     assert run() == ["1", "1", True]
     assert run(extra={"OPENBLAS_NUM_THREADS": "2"}) == ["2", "2", True]
@@ -193,13 +198,9 @@ def test_configure_keeps_mujoco_from_loading_opengl_unless_the_user_chose():
     code = ("import json, os, sys\nfrom graspdef import runtime\n{pre}import mujoco\n"
             "print(json.dumps([os.environ.get('MUJOCO_GL'), "
             "sorted({{m.split('.')[0] for m in sys.modules if m.split('.')[0] in ('glfw', 'OpenGL')}})]))")
-    env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
 
     def run(pre="runtime.configure()\n", extra=None):
-        r = subprocess.run([sys.executable, "-c", code.format(pre=pre)], capture_output=True, text=True,
-                           env=env | (extra or {}), cwd=ROOT, check=False)
-        assert r.returncode == 0, r.stderr
-        return json.loads(r.stdout.strip().splitlines()[-1])
+        return _fresh_json(code.format(pre=pre), "MUJOCO_GL", extra)
 
     assert run() == ["disable", []]
     assert run(pre="") == [None, ["glfw"]]                 # what configure saves: GLFW's import
