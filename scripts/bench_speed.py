@@ -103,6 +103,8 @@ def main() -> None:
                     help="collocation points per supported edge (one row per value; default 2)")
     ap.add_argument("--out", default="out/bench_speed")
     a = ap.parse_args()
+    if min(a.collocation) < 1:
+        ap.error(f"--collocation: points per edge must be positive integers, got {a.collocation}")
     reps = a.repeats + [a.repeats[-1]] * (len(a.sizes) - len(a.repeats))
     rows = []
     with code_trees(ROOT, a.ref, prefix="bench_speed_") as trees:
