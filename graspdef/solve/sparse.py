@@ -470,7 +470,7 @@ _PARDISO_IPARM = {
 #: instead of the improved one.  The improved matching is faster (10k pinched cylinder: 1.95 vs
 #: 2.26 s per factorisation, medians of 5), but its static pivoting is not backward-stable on
 #: every matrix: the 1/8 soda can at 96 x 96 cells with two collocation points per edge, with its
-#: nearly dependent support rows re-based into one orthonormal basis, perturbs one pivot, counts
+#: nearly dependent support rows re-based into one orthonormal basis (as they then were), perturbs one pivot, counts
 #: 961 negative pivots for 960 constraints and solves to a residual of 1e-3, while another
 #: orthonormal basis of the same rows (what OpenBLAS's LAPACK returns with two threads instead of
 #: one) factors exactly; SuperLU solves both to 1.5e-11 with the same displacements, so the

@@ -4,9 +4,9 @@ PARDISO's symmetric indefinite LDL^T pivots statically (Bunch-Kaufman inside sup
 weighted matching); on some regular saddle-point matrices its factorisation is not
 backward-stable: it perturbs a pivot, miscounts the inertia, or solves to a residual of 1e-3.
 Found on the 1/8 soda can at 96 x 96 cells with two collocation points per edge, whose nearly
-dependent support rows are re-based into an orthonormal basis by
-``problem.supports.well_conditioned_rows``: with OpenBLAS's LAPACK on two threads that basis
-differs (another basis of the same rows) and PARDISO, with the improved matching, counted 961
+dependent support rows were then re-based into an orthonormal basis by
+``problem.supports.well_conditioned_rows`` (now they are dropped): with OpenBLAS's LAPACK on two threads that basis
+differed (another basis of the same rows) and PARDISO, with the improved matching, counted 961
 negative pivots for 960 constraints, while SciPy's SuperLU solved the same matrix to 1.5e-11 with
 the same displacements.  The standard matching factors it exactly.  A factorisation that perturbs
 a pivot, a solve that fails its residual/backward-error check and a linear problem whose inertia
@@ -181,9 +181,12 @@ print(json.dumps({"u_A": s.probe("A").tolist(), "neg": s.kkt.n_negative, "m": le
 def test_the_can_solves_the_same_with_one_or_two_blas_threads():
     """The 1/8 soda can (R = 33.85 mm, t = 0.1 mm, 96 x 96 cells, two collocation points per edge,
     0.25 N at the pin), solved in fresh processes with OPENBLAS_NUM_THREADS = 1 and 2: both solve
-    (inertia = constraints, residual <= 1e-8) to the same displacement at the pin (1e-9 relative;
-    the support rows' basis differs between the two, their span does not).  On the development
-    machine the two-thread run failed before the robust retry (961 negative pivots for 960)."""
+    (inertia = constraints, residual <= 1e-8) to the same displacement at the pin (1e-9 relative).
+    On the development machine the two-thread run failed before the robust retry (961 negative
+    pivots for 960) when the nearly dependent support rows were re-based; now they are dropped, and
+    which rows are dropped must not depend on the thread count either (it did, by 1.5e-9 at the
+    pin, until ties between the symmetric loop's rows were broken by index:
+    ``problem.supports._leading_rows``)."""
     out = {}
     for threads in ("1", "2"):
         env = {**os.environ, "OPENBLAS_NUM_THREADS": threads, "PYTHONPATH": str(ROOT)}
