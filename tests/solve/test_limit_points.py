@@ -105,12 +105,19 @@ def test_bad_limit_point_options_are_one_clear_line(kw, msg):
 @pytest.mark.slow
 def test_pinched_cylinder_passes_its_small_limit_point_by_a_recorded_jump():
     """The 48 x 48 1/8 pinched cylinder (benchmarks/nonlinear/pinched_cylinder_large.toml, load
-    point driven inwards) has a small limit point of its control at lambda = 0.96202 (-W_A =
-    86.58): followed by arc length (measured once, 2026-11-26), the path turns back to a second
-    limit point at 0.90136 and forward again, reaching lambda = 1 at U_B = 41.58925.  Load
-    control without a step cap used to stop at it ("Newton diverges", 0.962018); with the cap of
-    the benchmark's curve comparison it used to jump over it unnoticed.  Now both record it as a
-    limit point passed by a jump and end on the arc-length path's state.  ~4 minutes."""
+    point driven inwards) loses stability just above lambda = 0.96.  Load control without a step
+    cap used to stop there ("Newton diverges"); with the cap of the benchmark's curve comparison it
+    used to jump over it unnoticed.  Now it records one limit point passed by a jump and ends, at
+    lambda = 1, on a stable state.
+
+    Where: the arc-length path of the same file (steps = 200, 2026-11-27) records the change of
+    stability (0 -> 1 negative eigenvalues) in the bracket [0.9584, 0.9677]; the load-controlled
+    path's limit point must lie in it (measured: 0.961337, U_B = 41.5855 at lambda = 1).  Until the
+    closed loops' nearly dependent support rows were dropped instead of re-based it was 0.96202
+    (asserted then to 1e-5 against an arc-length path that turned back there, U_B = 41.58925).  The
+    point is sensitive to the Nitsche rotation penalty of the symmetry edges (nitsche_gamma 40
+    instead of 20: 0.99908), which the arc-length path's spurious-mode check also names on coarse
+    steps: README, "Limit points in load control".  ~4 minutes."""
     text = (NL / "pinched_cylinder_large.toml").read_text()
     assert "n_theta = 48" in text and "n_z = 48" in text
     spec = load_problem(NL / "pinched_cylinder_large.toml")
@@ -121,8 +128,9 @@ def test_pinched_cylinder_passes_its_small_limit_point_by_a_recorded_jump():
     assert sol.completed, sol.stop_reason
     jumps = [cp for cp in sol.critical_points if cp["kind"] == "limit point (jumped)"]
     assert len(jumps) == 1, sol.critical_points
-    assert abs(jumps[0]["load_factor"] - 0.96202) <= 1e-5, jumps[0]
-    assert abs(sol.at(1.0).probes["B"][1] - 41.58925) <= 1e-4 * 41.58925, sol.at(1.0).probes
+    assert 0.9584 <= jumps[0]["load_factor"] <= 0.9677, jumps[0]
+    end = sol.at(1.0)
+    assert end.instability == 0, end.instability
 
 
 @pytest.mark.parametrize("line, msg", [
