@@ -23,8 +23,9 @@ the medians are over all of that tree's timed runs.
 ``--collocation 2 1``: the supports' collocation points per edge (``Problem.n_collocation``, a problem
 file's ``[solver] collocation``; default 2), one row per value, the processes of the values alternating
 like the trees'.  The cylinder's diaphragms are closed rings, where two points per edge give nearly
-dependent rows that graspdef replaces by dense orthonormal ones (``problem.supports.well_conditioned_rows``)
-and one point per edge gives sparse, well-conditioned rows.
+dependent rows, of which graspdef drops those within 1 % of the others' span
+(``problem.supports.well_conditioned_rows``; until 2026-11-27 it replaced them by dense orthonormal
+rows, which doubled the 100k factorisation), and one point per edge gives sparse, well-conditioned rows.
 """
 from __future__ import annotations
 
