@@ -754,6 +754,14 @@ class PathSolver:
                 why = " (a limit point of the load: the response softened towards it)" if limit else ""
                 floor = max(dmin, near) if limit else dmin
                 stalled = f"load step cut below {floor:.3g} at load factor {lam:.6g}{why}: {exc}"
+                soft = self.soft_terms(u, lam) if limit else ""
+                if soft:
+                    # a limit point made by a term that is not convex by itself (a Nitsche edge
+                    # term whose penalty no longer dominates): not the shell's, so no jump
+                    err = _Failed(f"{stalled}; the limit point is spurious: {soft}; the path stops at the "
+                                  "last stable point")
+                    err.diagnosed = True
+                    raise err from None
                 if opt.limit_points != "jump" or back is None or not limit:
                     raise _Failed(stalled) from None
                 first = min(abs(dlam0), abs(nxt - lam)) * sgn
