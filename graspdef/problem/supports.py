@@ -362,7 +362,8 @@ def independent_rows(C: sp.csr_matrix, rtol: float = 1e-9, dense_row: int = 10_0
 #: Largest condition number sigma_max / sigma_min of a cluster of constraint rows that is kept as
 #: it is.  PARDISO perturbs pivots below 1e-8 of the KKT matrix's norm (``graspdef.solve.sparse``)
 #: and a constraint pivot of the KKT matrix scales as sigma^2, so rows conditioned worse than
-#: 1e4 = (1e-8)^(-1/2) are re-based (:func:`well_conditioned_rows`).
+#: 1e4 = (1e-8)^(-1/2) are made well conditioned: nearly dependent rows dropped, or re-based
+#: (:func:`well_conditioned_rows`).
 ROW_COND_MAX = 1e4
 
 

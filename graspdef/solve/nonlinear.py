@@ -290,7 +290,7 @@ class NonlinearSolution(DisplacementField):
 
 
 class _Failed(Exception):
-    diagnosed = False             # the message already says which term made the tangent soft
+    diagnosed = False             # the softest-mode diagnosis ran already (its finding, if any, is in the message)
 
 
 class PathSolver:
@@ -763,7 +763,9 @@ class PathSolver:
                     err.diagnosed = True
                     raise err from None
                 if opt.limit_points != "jump" or back is None or not limit:
-                    raise _Failed(stalled) from None
+                    err = _Failed(stalled)
+                    err.diagnosed = limit             # soft_terms already ran at this point: nothing soft
+                    raise err from None
                 first = min(abs(dlam0), abs(nxt - lam)) * sgn
                 snapped = self._past(jumped, u, lam, nxt) or self._snap(u, lam, first)
                 if snapped is None:
