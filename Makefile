@@ -9,9 +9,9 @@ STAMP  := $(VENV)/.installed
 .PHONY: setup demo test test-slow clean system-packages
 
 # Debian packages the Python dependencies need at run time (installed when run as root):
-# libgomp1 (numba's OpenMP), libusb-1.0-0 (open3d), chromium + driver (browser tests), and
+# gcc and python3-dev (numba's pycc compiles and links the ahead-of-time kernels), libgomp1 (numba's OpenMP), libusb-1.0-0 (open3d), chromium + driver (browser tests), and
 # pymeshlab's shared libraries: libgl1, libopengl0, libfontconfig1, libgmp10 (it loads them at import)
-DEB_PACKAGES := libgomp1 libusb-1.0-0 chromium chromium-driver libgl1 libopengl0 libfontconfig1 libgmp10
+DEB_PACKAGES := gcc python3-dev libgomp1 libusb-1.0-0 chromium chromium-driver libgl1 libopengl0 libfontconfig1 libgmp10
 
 system-packages:
 	@if [ "$$(id -u)" = "0" ] && command -v apt-get >/dev/null 2>&1; then \
@@ -34,7 +34,18 @@ $(STAMP): pyproject.toml
 	@touch $(STAMP)
 	@echo "set-up done"
 
-setup: $(STAMP)
+# the ahead-of-time build of the compiled kernels (graspdef.compiled): small solves then need no
+# numba at run time (0.5 s of every process); rebuilt when a kernel source changes
+KERNEL_SOURCES := graspdef/compiled.py graspdef/shell/_kernels.py graspdef/shell/volume.py \
+                  graspdef/solve/_kernels.py graspdef/contact/_kernels.py
+AOT_STAMP := graspdef/_aot.json
+
+$(AOT_STAMP): $(STAMP) $(KERNEL_SOURCES)
+	@echo "compiling the ahead-of-time kernels ..."
+	@$(PY) -m graspdef.compiled >> $(SETUP_LOG) 2>&1 \
+	  || { tail -n 20 $(SETUP_LOG); echo "the ahead-of-time kernels were not built (see $(SETUP_LOG)): graspdef runs on numba's JIT alone, 0.5 s slower to start (tests/test_compiled.py fails)"; }
+
+setup: $(STAMP) $(AOT_STAMP)
 
 demo: setup
 	$(VENV)/bin/graspdef grasp tennis_ball --force 21.48 --out out/demo_tennis_ball

@@ -45,7 +45,7 @@ _LAZY = {
     "view": "graspdef.viewer",
 }
 #: the rooms (ARCHITECTURE.md) reachable as ``graspdef.<room>``, imported on first use (not cli, testing)
-_SUBPACKAGES = {"units", "runtime", "config", "geometry", "runs", "subdivision", "shell", "axisym", "problem", "solve",
+_SUBPACKAGES = {"units", "runtime", "compiled", "config", "geometry", "runs", "subdivision", "shell", "axisym", "problem", "solve",
                 "contact", "sim", "scans", "registration", "objects", "viewer", "report", "pipeline", "ranking",
                 "fit", "sweep", "bench"}
 

@@ -11,7 +11,7 @@ import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "graspdef"
 #: lowest first; a module may import graspdef modules of its own layer or of a lower one
-LAYERS = ["errors", "units", "runtime", "config", "testing", "geometry", "runs", "subdivision", "shell", "axisym",
+LAYERS = ["errors", "units", "runtime", "compiled", "config", "testing", "geometry", "runs", "subdivision", "shell", "axisym",
           "problem", "solve", "contact", "sim", "scans", "registration", "objects", "viewer", "report", "pipeline", "ranking",
           "fit", "sweep", "bench", "cli"]
 #: sibling rooms that must not import each other (ARCHITECTURE.md: "viewer | report")

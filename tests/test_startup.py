@@ -24,7 +24,8 @@ PLATE = ROOT / "benchmarks" / "plate_ss_uniform.toml"
 HEAVY = ("trimesh", "open3d", "mujoco", "viser", "dask", "distributed", "matplotlib", "numba", "numpy", "scipy")
 #: packages a linear solve of a problem file has no use for
 NOT_FOR_A_SOLVE = ("trimesh", "open3d", "mujoco", "viser", "dask", "distributed", "matplotlib", "pymeshlab", "coacd",
-                   "scipy.spatial")     # (locating a probe or a load needs no KD-tree: 0.12 s of start-up)
+                   "scipy.spatial",     # (locating a probe or a load needs no KD-tree: 0.12 s of start-up)
+                   "numba")             # (its kernels run from the ahead-of-time module: 0.5 s of start-up)
 
 #: the tail of every probe: which of the watched modules, and which subcommand modules, are loaded
 REPORT = ("\nimport json, sys\n"

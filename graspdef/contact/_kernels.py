@@ -7,13 +7,13 @@ Each takes the points P (k, 3) and a shift (3,) subtracted from every point (the
 advance s e), so no shifted copy of P is made."""
 from __future__ import annotations
 
-import numba as nb
 import numpy as np
 
+from ..compiled import kernel
 from ..shell._kernels import sorted_search
 
 
-@nb.njit(cache=True, fastmath=False)
+@kernel(aot=("Tuple((f8[::1], f8[:,::1], f8[::1], f8[::1]))(f8[:,::1], f8[::1], f8[::1], f8[:,::1], f8[::1], f8, f8[::1])",))
 def box_distance(P, shift, c, R, h, rounding, e):
     """Rounded box (centre c, axes = columns of R, inner half extents h, edge radius rounding):
     phi (k,), outward unit normal n (k, 3), and along the unit vector e the derivatives of
@@ -58,7 +58,7 @@ def box_distance(P, shift, c, R, h, rounding, e):
     return phi, n, d1, d2
 
 
-@nb.njit(cache=True, fastmath=False)
+@kernel()
 def capsule_distance(P, shift, a, b, radius, e):
     """Capsule (segment a-b, radius): phi (k,), outward unit normal n (k, 3), and along the unit
     vector e the derivatives of phi(p - s e) in s: -n.e (k,) and e.H.e (k,)."""
@@ -97,7 +97,7 @@ def capsule_distance(P, shift, a, b, radius, e):
 # ------------------------------------------------------------------------------------------------
 # the sample operator S (graspdef.contact.sampling.SampleOperator): rows of a CSR matrix (ptr,
 # cols, vals), each sample point p_k = sum_j vals[j] x[cols[j]] over its row's entries
-@nb.njit(cache=True)
+@kernel(aot=("f8[:,::1](i8[::1], i8[::1], f8[::1], f8[:,::1], i8[::1])",))
 def sample_rows_points(ptr, cols, vals, x, rows):
     """The points (k, 3) of the sample ``rows`` (k,) at control points x (n, 3)."""
     k = rows.shape[0]
@@ -113,7 +113,7 @@ def sample_rows_points(ptr, cols, vals, x, rows):
     return out
 
 
-@nb.njit(cache=True)
+@kernel(aot=("f8[::1](i8[::1], i8[::1], f8[::1], f8[:,::1], i8[::1], i8)",))
 def sample_rows_gradient(ptr, cols, vals, g, rows, n):
     """S[rows]^T g for per-sample vectors g (k, 3): the control points' (n, 3), flattened."""
     out = np.zeros(3 * n)
@@ -128,7 +128,7 @@ def sample_rows_gradient(ptr, cols, vals, g, rows, n):
     return out
 
 
-@nb.njit(cache=True)
+@kernel(aot=("UniTuple(i8[::1], 2)(i8[::1], i8[::1], i8[::1], i8[::1])",))
 def sample_pair_positions(ptr, cols, indptr, bcols):
     """For every row of S, the block positions in the block pattern (indptr, bcols; sorted
     columns) of each pair (cols[i], cols[j]) of its entries, row by row in (i, j) order: (pptr,
@@ -152,7 +152,7 @@ def sample_pair_positions(ptr, cols, indptr, bcols):
     return pptr, pos
 
 
-@nb.njit(cache=True)
+@kernel(aot=("void(i8[::1], f8[::1], i8[::1], i8[::1], i8[::1], i8[::1], f8[:,:,::1], i8[::1], f8[::1])",))
 def sample_rows_hessian(ptr, vals, pptr, pos, base, stride, H, rows, out):
     """Add sum_k (S_k x I3)^T H_k (S_k x I3) for the sample ``rows`` (k,) with 3 x 3 blocks H
     (k, 3, 3) into ``out``, the data of the pattern's scalar CSR matrix (block p's entry (a, b)

@@ -2,11 +2,12 @@
 ``energy.py`` computes the same quantities and the tests compare the two."""
 from __future__ import annotations
 
-import numba as nb
 import numpy as np
 
+from ..compiled import kernel, prange
 
-@nb.njit(cache=True, parallel=True, fastmath=False)
+
+@kernel(parallel=True)
 def material_hessian_blocks(D, J, C, dstride, Hg=None):
     """sum_q G_q^T C_q G_q per face with G = ds/dx, G[i, s, a] = sum_K D[s, K] J[i, K, a].
 
@@ -19,7 +20,7 @@ def material_hessian_blocks(D, J, C, dstride, Hg=None):
     nf, nq = J.shape[0], J.shape[1]
     S = D.shape[2]
     out = np.zeros((nf, S, S, 3, 3))
-    for f in nb.prange(nf):
+    for f in prange(nf):
         df = f * dstride
         G = np.empty((6, S, 3))
         CG = np.empty((6, S, 3))
@@ -72,7 +73,7 @@ def material_hessian_blocks(D, J, C, dstride, Hg=None):
     return out
 
 
-@nb.njit(cache=True)
+@kernel()
 def scatter_blocks(data, index, blocks, base, stride):
     """Add blocks[f, s, t] (3x3) into a scalar CSR ``data`` array: the block goes to block
     position p = index[f*S*S + s*S + t], whose entry (a, b) lives at base[p] + a*stride[p] + b
@@ -90,7 +91,7 @@ def scatter_blocks(data, index, blocks, base, stride):
                 k += 1
 
 
-@nb.njit(cache=True)
+@kernel()
 def sorted_search(cols, lo, hi, c):
     """The first position in cols[lo:hi] (sorted) whose value is not below c (hi if none)."""
     while lo < hi:
@@ -102,13 +103,13 @@ def sorted_search(cols, lo, hi, c):
     return lo
 
 
-@nb.njit(cache=True, parallel=True)
+@kernel(parallel=True, work=0, aot=("i8[::1](i8[:,::1], i8[::1], i8[::1])",))
 def block_positions(stencils, indptr, cols):
     """Position in the block-CSR pattern (indptr, cols; sorted columns) of every stencil pair
     (stencils[f, s], stencils[f, t]), flattened in (f, s, t) order; binary search per row."""
     nf, S = stencils.shape
     out = np.empty(nf * S * S, np.int64)
-    for f in nb.prange(nf):
+    for f in prange(nf):
         for s in range(S):
             r = stencils[f, s]
             lo0, hi0 = indptr[r], indptr[r + 1]
@@ -117,7 +118,7 @@ def block_positions(stencils, indptr, cols):
     return out
 
 
-@nb.njit(cache=True)
+@kernel(aot=("UniTuple(i8[::1], 2)(i8[::1], i8[::1], i4[::1], i4[::1])",))     # int64 indices (> 2**31 entries): JIT
 def scalar_pattern(indptr, cols, sptr, idx):
     """The scalar CSR pattern of the 3x3-block pattern (indptr, cols), written into ``sptr``
     (3 n + 1) and ``idx`` (9 nnzb) (scalar indptr and indices, of the caller's integer type);
@@ -150,7 +151,7 @@ def scalar_pattern(indptr, cols, sptr, idx):
 # fused kernels of the energy, gradient and Hessian (energy.ShellEnergy); numpy reference path:
 # ShellEnergy._local with kinematics.strains / strain_jacobian / strain_hessian_contract
 # ------------------------------------------------------------------------------------------------
-@nb.njit(cache=True, parallel=True, fastmath=False)
+@kernel(parallel=True, work=1, aot=("Tuple((f8[:,:,:,::1], f8[:,:,::1]))(f8[:,::1], i8[:,::1], f8[:,:,:,::1], i8, f8[:,:,::1], f8[:,:,::1])",))
 def point_strains(x, stencils, D, dstride, rest_a, rest_b):
     """Surface derivatives y (nf, nq, 5, 3) = sum_s D[f, q, s, K] x[stencils[f, s]] and the strain
     vector s (nf, nq, 6) of ``kinematics.strains`` at every quadrature point.
@@ -161,7 +162,7 @@ def point_strains(x, stencils, D, dstride, rest_a, rest_b):
     nq = D.shape[1]
     y = np.empty((nf, nq, 5, 3))
     s = np.empty((nf, nq, 6))
-    for f in nb.prange(nf):
+    for f in prange(nf):
         df = f * dstride
         for q in range(nq):
             for K in range(5):
@@ -188,7 +189,7 @@ def point_strains(x, stencils, D, dstride, rest_a, rest_b):
     return y, s
 
 
-@nb.njit(cache=True, fastmath=False)
+@kernel()
 def _point_jacobian(y, J, n):
     """ds/dy at one point into J (6, 15) (column 3 K + a), as ``kinematics.strain_jacobian``;
     the unit normal into n (3,); returns the area element |a1 x a2|."""
@@ -224,14 +225,14 @@ def _point_jacobian(y, J, n):
     return j
 
 
-@nb.njit(cache=True, fastmath=False)
+@kernel()
 def _skew(v, A):
     A[0, 0], A[0, 1], A[0, 2] = 0.0, -v[2], v[1]
     A[1, 0], A[1, 1], A[1, 2] = v[2], 0.0, -v[0]
     A[2, 0], A[2, 1], A[2, 2] = -v[1], v[0], 0.0
 
 
-@nb.njit(cache=True, fastmath=False)
+@kernel()
 def _mm3(A, B, C):
     """C = A @ B (3 x 3)."""
     for i in range(3):
@@ -239,7 +240,7 @@ def _mm3(A, B, C):
             C[i, k] = A[i, 0] * B[0, k] + A[i, 1] * B[1, k] + A[i, 2] * B[2, k]
 
 
-@nb.njit(cache=True, fastmath=False)
+@kernel()
 def _point_geometric(y, sig, n, j, Hy, A1, A2, Hm, M, M2, PA):
     """Add the stress (geometric) part sum_i sig_i d2 s_i/dy2 (``kinematics.
     strain_hessian_contract``) to Hy (15, 15).  The curvature terms are linear in the second
@@ -311,7 +312,7 @@ def _point_geometric(y, sig, n, j, Hy, A1, A2, Hm, M, M2, PA):
                     Hy[3 * r + b, 3 * blk + a] += v
 
 
-@nb.njit(cache=True, parallel=True, fastmath=False)
+@kernel(parallel=True, work=0, aot=("void(f8[:,:,:,::1], f8[:,::1], f8[:,:,::1], f8[:,:,:,::1], f8[:,:,:,::1], f8[:,:,:,::1], i8, i8[:,::1], i8[::1], i8[::1], i8[::1], i8[::1], i8[::1], i8[::1], i8[::1], f8[:,::1], f8[::1], b1)",))
 def assemble_elements(y, w, dW, ddW, D, Dt, dstride, stencils, order, bstart, cblocks, cstart,
                       index, base, stride, grad, bdata, hess):
     """Gradient and (if ``hess``) Hessian of sum_q w_q W(s(y_q)) of every face, added in place
@@ -336,7 +337,7 @@ def assemble_elements(y, w, dW, ddW, D, Dt, dstride, stencils, order, bstart, cb
     ncol = cstart.shape[0] - 1
     u1, u2, u3, uS4 = np.uint64(1), np.uint64(2), np.uint64(3), np.uint64(S4)
     for col in range(ncol):
-        for bi in nb.prange(cstart[col], cstart[col + 1]):
+        for bi in prange(cstart[col], cstart[col + 1]):
             blk_id = cblocks[bi]
             J = np.empty((6, 15))
             CJ = np.empty((6, 6))
@@ -519,7 +520,7 @@ def assemble_elements(y, w, dW, ddW, D, Dt, dstride, stencils, order, bstart, cb
 NEO_HOOKEAN, MOONEY_RIVLIN, EXPONENTIAL, COMPRESSIBLE_NEO_HOOKEAN = 0, 1, 2, 3
 
 
-@nb.njit(cache=True, fastmath=False)
+@kernel()
 def _incompressible_psi(kind, par, p, q):
     """psi(c, d) and derivatives of the incompressible laws (hyperelastic._Incompressible._psi)."""
     d = 1.0 + p + q
@@ -556,7 +557,7 @@ def _incompressible_psi(kind, par, p, q):
     return W, pc, pd, pcc, pcd, pdd
 
 
-@nb.njit(cache=True, fastmath=False)
+@kernel()
 def _compressible_psi(par, p, q, tol_eps, max_iter):
     """Compressible neo-Hookean psi with C33 from plane stress (hyperelastic.
     CompressibleNeoHookean._psi / _log_c33); the last value is False if Newton did not converge."""
@@ -584,7 +585,7 @@ def _compressible_psi(par, p, q, tol_eps, max_iter):
     return psi, pc, pd, 0.0, 0.0, pdd, ok
 
 
-@nb.njit(cache=True, parallel=True, fastmath=False)
+@kernel(parallel=True, work=2, aot=("Tuple((f8[::1], f8[:,::1], f8[:,:,::1], b1[::1]))(i8, f8[::1], f8[:,::1], f8[:,::1], f8[::1], f8[::1], f8[::1], i8, f8, i8)",))
 def density_points(kind, par, s, ri, half, xg, wg, order, tol_eps, max_iter):
     """Energy per unit rest area W (n,) and, for order >= 1 / 2, dW/ds (n, 6) and d2W/ds2
     (n, 6, 6) of a thickness-integrated hyperelastic material at n points; the compiled
@@ -601,7 +602,7 @@ def density_points(kind, par, s, ri, half, xg, wg, order, tol_eps, max_iter):
     dW = np.empty((n, 6)) if order >= 1 else np.empty((0, 6))
     ddW = np.empty((n, 6, 6)) if order >= 2 else np.empty((0, 6, 6))
     conv = np.ones(n, np.bool_)
-    for i in nb.prange(n):
+    for i in prange(n):
         A11, A22, A12 = ri[i, 0], ri[i, 1], ri[i, 2]
         det_inv = A11 * A22 - A12 * A12
         gc0, gc1, gc2 = 2.0 * A11, 2.0 * A22, 2.0 * A12

@@ -14,17 +14,17 @@ antisymmetric in (s, t), so the assembled Hessian is symmetric.
 """
 from __future__ import annotations
 
-import numba as nb
 import numpy as np
 import scipy.sparse as sp
 
+from ..compiled import kernel
 from .energy import BlockPattern, block_pattern
 from .model import Shell
 
 _CHUNK = 4096
 
 
-@nb.njit(cache=True)
+@kernel(aot=("f8(f8[:,::1], i8[:,::1], f8[:,:,::1], f8[:,:,:,::1], f8[::1], i8, i8, i8[::1], i8[::1], i8[::1], f8[:,::1], f8[::1])",))
 def _volume_terms(x, stencils, N, dN, w, nstride, order, index, base, bstride, grad, data):
     """Fused value / gradient (order >= 1) / Hessian (order 2, added into the scalar CSR ``data``
     of the shell's block pattern: block p = index[(f S + s) S + t], entry (a, b) at

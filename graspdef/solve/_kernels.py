@@ -1,11 +1,12 @@
 """Compiled kernels of the sparse solver (numba): the pattern of the KKT matrix's upper triangle and its values."""
 from __future__ import annotations
 
-import numba as nb
 import numpy as np
 
+from ..compiled import kernel
 
-@nb.njit(cache=True)
+
+@kernel(aot=("UniTuple(i8[::1], 3)(i8[::1], i8[::1], i8[::1], i8[::1], i8, i8)",))
 def kkt_upper_pattern(k_indptr, k_indices, ct_indptr, ct_indices, n, m):
     """CSR pattern of the upper triangle of [[K, C^T], [C, 0]] (n + m rows) and where each entry
     comes from.  Row i < n holds K's entries of row i with column >= i (in K's order), then C^T's
@@ -47,7 +48,7 @@ def kkt_upper_pattern(k_indptr, k_indices, ct_indptr, ct_indices, n, m):
     return indptr, indices, src
 
 
-@nb.njit(cache=True)
+@kernel(aot=("f8[::1](i8[::1], f8[::1], f8[::1], f8)",))
 def kkt_upper_values(src, k_data, ct_data, scale):
     """The values of :func:`kkt_upper_pattern`'s entries: K.data[src] where src >= 0,
     ``scale`` C^T.data[-1 - src] where it points into C^T, 0 on the constraint block's diagonal."""

@@ -1,0 +1,281 @@
+"""graspdef's compiled kernels: one Python source, two builds.
+
+A kernel is a plain Python function of arrays decorated with :func:`kernel` in one of the
+:data:`KERNEL_MODULES`.  A call runs
+
+* the **ahead-of-time build** -- a C extension ``graspdef/_aot*.so`` that ``make setup`` compiles
+  from the same sources with numba's ``pycc`` (``python -m graspdef.compiled``), serial -- when it
+  exists, was built from the kernel sources as they are now (their SHA-256 is kept beside it, in
+  ``_aot.json``), holds the kernel for these argument types, and the call is small: a kernel that
+  is parallel in the JIT build goes there only while its work (``args[work].shape[0]``) is at most
+  :data:`SERIAL_MAX`;
+* otherwise the **JIT build**: numba's ``njit`` (``cache=True``, parallel where declared), which
+  compiles (or loads from numba's on-disk cache) every kernel of the module on the first such call.
+
+Why (issue 17, README "Start-up"): numba costs every process 0.17 s to import and 0.3-0.4 s on its
+first call even when its on-disk cache is warm (it installs its typing and lowering registries);
+the plate of 1,681 control vertices took 1.2-1.6 s as a whole process, of which ~0.5 s was that.
+The ahead-of-time module loads like any extension (a few ms) and needs no numba at run time.
+Large problems keep the parallel JIT build (2 cores: the shell's Hessian assembly about 1.8x
+faster), where numba's fixed cost is small against the solve.
+
+Both builds compute the same numbers: the kernels' parallel loops write disjoint outputs (no
+reductions across iterations) and nothing is compiled with fastmath, so serial and parallel,
+ahead-of-time and JIT agree to the bit (``tests/test_compiled.py`` checks it).  A missing or
+stale ahead-of-time module only costs speed: the JIT build is used, never old code.
+
+:func:`kernel`'s registry is filled at import by the kernel modules' decorators (static, like
+numba's own dispatchers); nothing is compiled or loaded before the first call.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import importlib
+import json
+import logging
+import sys
+from pathlib import Path
+
+import numpy as np
+
+log = logging.getLogger(__name__)
+
+#: the modules that define kernels (every one is hashed into the ahead-of-time module's stamp)
+KERNEL_MODULES = ("graspdef.shell._kernels", "graspdef.shell.volume", "graspdef.solve._kernels",
+                  "graspdef.contact._kernels")
+
+#: a kernel that is parallel in the JIT build runs serially ahead of time only up to this much work
+#: (``args[work].shape[0]``: faces, points or rows): the 40 x 40 plate's 3,200 faces go there, the
+#: 2,562-vertex ball's 5,120 faces (a nonlinear path of ~50 Hessians) keep both cores
+SERIAL_MAX = 4096
+
+AOT_NAME = "_aot"                              # graspdef/_aot*.so and graspdef/_aot.json
+_HERE = Path(__file__).resolve().parent
+
+#: builtins' range until the JIT build replaces a kernel module's ``prange`` by numba's
+prange = range
+
+_REGISTRY: dict[str, list["Kernel"]] = {}      # module name -> its kernels, in definition order
+_aot_state: dict = {}                          # "module": the loaded ahead-of-time module or None
+
+
+class Kernel:
+    """A compiled kernel (see the module's docstring).  ``signatures``: numba signature strings
+    of the ahead-of-time exports (none: JIT only, e.g. a helper that only kernels call)."""
+
+    def __init__(self, fn, parallel: bool, signatures: tuple[str, ...], work: int):
+        self.py_func = fn
+        self.parallel = parallel
+        self.signatures = signatures
+        self.work = work
+        self.__name__, self.__qualname__, self.__doc__ = fn.__name__, fn.__qualname__, fn.__doc__
+        self.__module__ = fn.__module__
+        self._jit = None                 # numba dispatcher, once the JIT build is made
+        self._aot: list | None = None    # the ahead-of-time exports (empty: none usable)
+        _REGISTRY.setdefault(fn.__module__, []).append(self)
+
+    def __repr__(self):
+        return f"<kernel {self.__module__}.{self.__name__}>"
+
+    def export_name(self, i: int) -> str:
+        return f"{self.__module__.rsplit('.', 2)[-2]}_{self.__module__.rsplit('.', 1)[-1].lstrip('_')}__{self.__name__}__{i}"
+
+    def __call__(self, *args):
+        if self._aot is None:
+            self._aot = _aot_exports(self)
+        if self._aot and (not self.parallel or args[self.work].shape[0] <= SERIAL_MAX):
+            for f, spec in self._aot:
+                if _matches(args, spec):
+                    return f(*args)
+        return self.jit(*args)
+
+    @property
+    def jit(self):
+        """The JIT build (numba dispatcher); compiles the whole module's kernels on first use."""
+        if self._jit is None:
+            _jit_module(self.__module__)
+        return self._jit
+
+
+def kernel(*, parallel: bool = False, aot: tuple[str, ...] | list[str] = (), work: int = 0):
+    """Decorator of a kernel: ``parallel`` -- its ``prange`` loops run on all cores in the JIT
+    build; ``aot`` -- numba signature strings to export ahead of time; ``work`` -- the argument
+    whose ``shape[0]`` measures a parallel kernel's work (:data:`SERIAL_MAX`)."""
+    def wrap(fn):
+        return Kernel(fn, parallel, tuple(aot), work)
+    return wrap
+
+
+def kernels() -> list[Kernel]:
+    """Every kernel of :data:`KERNEL_MODULES` (importing them)."""
+    for name in KERNEL_MODULES:
+        importlib.import_module(name)
+    return [k for name in KERNEL_MODULES for k in _REGISTRY.get(name, [])]
+
+
+def _jit_module(name: str) -> None:
+    """The JIT build of every kernel of module ``name``: numba dispatchers of copies of the kernels'
+    functions whose globals are the module's with every :class:`Kernel` (of this module or imported
+    from another kernel module) replaced by its dispatcher and ``prange`` by numba's -- kernels
+    calling kernels compile against dispatchers, while the module itself keeps its Kernel objects
+    (an import of a kernel always gets the object that chooses between the builds)."""
+    import types
+
+    import numba
+
+    mod = sys.modules[name]
+    ns = dict(vars(mod))
+    for key, val in list(ns.items()):
+        if isinstance(val, Kernel) and val.__module__ != name:
+            ns[key] = val.jit
+    if ns.get("prange") is range:
+        ns["prange"] = numba.prange
+    mine = [k for k in _REGISTRY.get(name, []) if k._jit is None]
+    for k in mine:
+        f = k.py_func
+        copy = types.FunctionType(f.__code__, ns, f.__name__, f.__defaults__, f.__closure__)
+        copy.__qualname__, copy.__doc__, copy.__kwdefaults__ = f.__qualname__, f.__doc__, f.__kwdefaults__
+        k._jit = numba.njit(cache=True, parallel=k.parallel)(copy)
+    for k in _REGISTRY.get(name, []):
+        ns[k.__name__] = k._jit
+
+
+def source_stamp() -> str:
+    """SHA-256 of the kernel modules' source files and of this file: the ahead-of-time module is
+    used only if it was built from exactly these."""
+    h = hashlib.sha256()
+    for name in KERNEL_MODULES:
+        spec = importlib.util.find_spec(name)
+        h.update(name.encode() + b"\0" + Path(spec.origin).read_bytes() + b"\0")
+    h.update(Path(__file__).read_bytes())
+    return h.hexdigest()
+
+
+def _matches(args, spec) -> bool:
+    """Whether ``args`` have the types of an ahead-of-time export's signature (``spec`` from
+    ``_aot.json``).  pycc's wrappers do not check: an int32 array passed for an int64 one is read
+    as int64 (a crash or wrong numbers), so nothing goes there unchecked."""
+    if len(args) != len(spec):
+        return False
+    for a, s in zip(args, spec):
+        kind = s[0]
+        if kind == "a":
+            if not (isinstance(a, np.ndarray) and a.dtype.name == s[1] and a.ndim == s[2]
+                    and (s[3] != "C" or a.flags.c_contiguous)):
+                return False
+        elif kind == "i":
+            if isinstance(a, (bool, np.bool_)) or not isinstance(a, (int, np.integer)):
+                return False
+        elif kind == "f":
+            if isinstance(a, (bool, np.bool_)) or not isinstance(a, (float, int, np.floating, np.integer)):
+                return False
+        elif kind == "b":
+            if not isinstance(a, (bool, np.bool_)):
+                return False
+        else:
+            return False
+    return True
+
+
+def _arg_spec(t) -> list:
+    """An argument's numba type as ``_matches`` checks it: ["a", dtype, ndim, layout] for an
+    array, ["i"], ["f"] or ["b"] for an integer, float or boolean scalar."""
+    from numba.core import types
+
+    if isinstance(t, types.Array):
+        return ["a", str(t.dtype), t.ndim, t.layout]
+    for cls, kind in ((types.Boolean, "b"), (types.Integer, "i"), (types.Float, "f")):
+        if isinstance(t, cls):
+            return [kind]
+    raise TypeError(f"an ahead-of-time kernel argument must be an array or a scalar, not {t}")
+
+
+def _aot_exports(k: Kernel) -> list:
+    """The ahead-of-time exports of kernel ``k`` as (function, argument spec) pairs."""
+    mod = _aot_module()
+    if mod is None:
+        return []
+    specs = _aot_state["exports"]
+    return [(getattr(mod, n), specs[n]) for n in (k.export_name(i) for i in range(len(k.signatures)))
+            if n in specs and hasattr(mod, n)]
+
+
+def _aot_module():
+    """The ahead-of-time module if it is there and current, else None (once per process)."""
+    if "module" not in _aot_state:
+        _aot_state["module"] = None
+        stamp_file = _HERE / f"{AOT_NAME}.json"
+        try:
+            stamp = json.loads(stamp_file.read_text())
+        except (OSError, ValueError):
+            _aot_state["why"] = f"not built ({stamp_file.name} missing)"
+        else:
+            if stamp.get("source_sha256") != source_stamp():
+                _aot_state["why"] = "stale (built from other kernel sources)"
+            else:
+                try:
+                    _aot_state["module"] = importlib.import_module(f"graspdef.{AOT_NAME}")
+                    _aot_state["exports"] = stamp["exports"]
+                except ImportError as e:
+                    _aot_state["why"] = f"not loadable ({e})"
+        if _aot_state["module"] is None:
+            log.debug("ahead-of-time kernels %s: the JIT build is used", _aot_state["why"])
+    return _aot_state["module"]
+
+
+def aot_status() -> str:
+    """One line: whether the ahead-of-time kernels are in use, and why not if not."""
+    mod = _aot_module()
+    if mod is not None:
+        return f"ahead-of-time kernels in use: {Path(mod.__file__).name}"
+    return f"ahead-of-time kernels {_aot_state['why']}: numba's JIT build only (build them: python -m graspdef.compiled)"
+
+
+def _signature(text: str):
+    """A numba signature from its string (numba's type names: f8[:, ::1], i8, UniTuple(...), ...).
+    Read-only arrays match a signature's writable array type (the compiled code is the same;
+    ``_matches`` checks dtype, dimensions and layout, which are what the memory layout needs)."""
+    from numba.core import types
+
+    return eval(text, {"__builtins__": {}}, dict(vars(types)))
+
+
+def build(out_dir: Path = _HERE, verbose: bool = False) -> Path:
+    """Compile every kernel's ``aot`` signatures into ``out_dir/_aot*.so`` (numba's pycc; needs a C
+    compiler) and write the source stamp ``_aot.json`` beside it; returns the module's path."""
+    import warnings
+
+    kernels()
+    for name in KERNEL_MODULES:
+        _jit_module(name)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")        # pycc's deprecation notice
+        from numba.pycc import CC
+
+        cc = CC(AOT_NAME)
+        cc.output_dir = str(out_dir)
+        cc.verbose = verbose
+        exports = {}
+        for name in KERNEL_MODULES:
+            for k in _REGISTRY.get(name, []):
+                for i, text in enumerate(k.signatures):
+                    sig = _signature(text)
+                    cc.export(k.export_name(i), sig)(k.jit.py_func)    # globals: the dispatchers
+                    exports[k.export_name(i)] = [_arg_spec(t) for t in sig.args]
+        stamp_file = Path(out_dir) / f"{AOT_NAME}.json"
+        stamp_file.unlink(missing_ok=True)
+        cc.compile()
+    so = next(Path(out_dir).glob(f"{AOT_NAME}.*.so"))
+    stamp_file.write_text(json.dumps({"source_sha256": source_stamp(), "exports": exports}) + "\n")
+    return so
+
+
+if __name__ == "__main__":
+    import time
+
+    from graspdef import compiled     # the kernel modules register with this module, not __main__
+
+    t0 = time.perf_counter()
+    path = compiled.build(verbose="-v" in sys.argv)
+    print(f"built {path} in {time.perf_counter() - t0:.1f} s")
