@@ -153,29 +153,35 @@ def source_stamp() -> str:
 
 
 def _matches(args, spec) -> bool:
-    """Whether ``args`` have the types of an ahead-of-time export's signature (``spec`` from
-    ``_aot.json``).  pycc's wrappers do not check: an int32 array passed for an int64 one is read
+    """Whether ``args`` have the types of an ahead-of-time export's signature (``spec``: its
+    :func:`_checks`).  pycc's wrappers do not check: an int32 array passed for an int64 one is read
     as int64 (a crash or wrong numbers), so nothing goes there unchecked."""
     if len(args) != len(spec):
         return False
-    for a, s in zip(args, spec):
-        kind = s[0]
+    for a, (kind, dtype, ndim, contiguous) in zip(args, spec):
         if kind == "a":
-            if not (isinstance(a, np.ndarray) and a.dtype.name == s[1] and a.ndim == s[2]
-                    and (s[3] != "C" or a.flags.c_contiguous)):
+            if not isinstance(a, np.ndarray) or a.dtype != dtype or a.ndim != ndim \
+                    or (contiguous and not a.flags.c_contiguous):
+                return False
+        elif isinstance(a, (bool, np.bool_)):
+            if kind != "b":
                 return False
         elif kind == "i":
-            if isinstance(a, (bool, np.bool_)) or not isinstance(a, (int, np.integer)):
+            if not isinstance(a, (int, np.integer)):
                 return False
         elif kind == "f":
-            if isinstance(a, (bool, np.bool_)) or not isinstance(a, (float, int, np.floating, np.integer)):
-                return False
-        elif kind == "b":
-            if not isinstance(a, (bool, np.bool_)):
+            if not isinstance(a, (float, int, np.floating, np.integer)):
                 return False
         else:
             return False
     return True
+
+
+def _checks(spec: list) -> tuple:
+    """An export's argument spec from ``_aot.json`` as :func:`_matches` reads it: per argument
+    (kind, numpy dtype, dimensions, C-contiguous required)."""
+    return tuple((s[0], np.dtype(s[1]), s[2], s[3] == "C") if s[0] == "a" else (s[0], None, 0, False)
+                 for s in spec)
 
 
 def _arg_spec(t) -> list:
@@ -216,7 +222,7 @@ def _aot_module():
             else:
                 try:
                     _aot_state["module"] = importlib.import_module(f"graspdef.{AOT_NAME}")
-                    _aot_state["exports"] = stamp["exports"]
+                    _aot_state["exports"] = {n: _checks(v) for n, v in stamp["exports"].items()}
                 except ImportError as e:
                     _aot_state["why"] = f"not loadable ({e})"
         if _aot_state["module"] is None:
