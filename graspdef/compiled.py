@@ -247,6 +247,13 @@ def _signature(text: str):
     return eval(text, {"__builtins__": {}}, dict(vars(types)))
 
 
+def builds_used() -> dict:
+    """Which builds this process's kernels have used so far (for a run's provenance): the
+    ahead-of-time module's status line and the kernel modules numba's JIT has compiled."""
+    return {"ahead_of_time": aot_status(),
+            "jit": sorted(n for n, ks in _REGISTRY.items() if any(k._jit is not None for k in ks))}
+
+
 def build(out_dir: Path = _HERE, verbose: bool = False) -> Path:
     """Compile every kernel's ``aot`` signatures into ``out_dir/_aot*.so`` (numba's pycc; needs a C
     compiler) and write the source stamp ``_aot.json`` beside it; returns the module's path."""

@@ -147,3 +147,14 @@ def test_a_stale_module_is_not_used(monkeypatch, fresh_state):
 
     out = kkt_upper_values(np.array([1, 0, -1, -3], np.int64), np.array([5.0, 6.0]), np.array([7.0, 8.0]), 2.0)
     assert list(out) == [6.0, 5.0, 14.0, 0.0]
+
+
+def test_a_run_folder_records_which_builds_ran(tmp_path):
+    """provenance.json names the ahead-of-time module in use and the modules the JIT compiled."""
+    from graspdef.runs.provenance import write_provenance, read_provenance
+    from graspdef.solve._kernels import kkt_upper_values
+
+    kkt_upper_values(np.array([0], np.int64), np.array([1.0]), np.array([2.0]), 1.0)
+    k = read_provenance(write_provenance(tmp_path).parent)["kernels"]
+    assert k["ahead_of_time"] == compiled.aot_status() and k["ahead_of_time"].startswith("ahead-of-time kernels in use")
+    assert set(k["jit"]) <= set(compiled.KERNEL_MODULES)

@@ -78,6 +78,8 @@ def provenance_record(config: dict | None = None, command: list[str] | None = No
         "python": sys.version.split()[0],
         "platform": platform.platform(),
         "packages": packages,
+        # the compiled kernels' builds (graspdef.compiled; read only if the process loaded it)
+        "kernels": sys.modules["graspdef.compiled"].builds_used() if "graspdef.compiled" in sys.modules else None,
     }
 
 
