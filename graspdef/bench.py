@@ -387,3 +387,67 @@ def run_nonlinear_benchmarks(folder: Path, pattern: str = "*",
                  f"({worst['name']}), {worst['seconds']:.1f} s")
         records += rs
     return records
+
+
+# ---------------------------------------------------------------------------------------------
+# the compiled kernels' two builds (graspdef.compiled)
+def kernel_workout(progress: Callable[[str], None] = lambda m: None) -> None:
+    """Small solves that call every compiled kernel with an ahead-of-time export: the Tian & Jia
+    plate (linear: patterns, strains, the shell's assembly, the KKT matrix), a neo-Hookean ball
+    holding gas between two point loads (densities, enclosed volume), two pads with friction and
+    two pins squeezing a sphere (box and capsule distances, the contact samples' gather, scatter
+    and Hessian)."""
+    from .contact.barrier import Capsule, FingerContact, RoundedBox
+    from .contact.friction import FingerFriction
+    from .geometry import icosphere
+    from .problem.loads import PointLoad
+    from .problem.potentials import EnclosedGas
+    from .problem.problem import Problem
+    from .problem.supports import RigidModes
+    from .shell.hyperelastic import NeoHookean
+    from .shell.materials import LinearElastic
+    from .shell.model import Shell
+    from .solve.nonlinear import PathOptions, solve_nonlinear
+
+    progress("kernels: the plate (linear)")
+    solve_linear(load_problem(Path(__file__).resolve().parents[1] / "benchmarks" / "plate_ss_uniform.toml").problem)
+    R, t = 0.0325, 0.0025
+    m = icosphere(radius=R, subdivisions=2)
+    progress("kernels: a neo-Hookean ball with gas")
+    pr = Problem(Shell(m.vertices, m.faces, NeoHookean(1e6 / 3), t), [EnclosedGas(8e4)], [RigidModes()])
+    top, bot = pr.locate((0, 0, R)), pr.locate((0, 0, -R))
+    pr.loads += [PointLoad(top.face, top.bary, (0, 0, -2.0)), PointLoad(bot.face, bot.bary, (0, 0, 2.0))]
+    if not solve_nonlinear(pr, PathOptions(steps=2)).completed:
+        raise RuntimeError("kernel workout: the ball's path stopped")
+    shell = Shell(m.vertices, m.faces, LinearElastic(1e6, 0.45), 0.002)
+    h = 0.001                                            # half the wall
+
+    def pad(side):
+        c = np.array([side * (R + h + 0.002), 0.0, 0.0])
+        return RoundedBox(tuple(c), tuple(map(tuple, np.eye(3))), (0.002, 0.008, 0.008), 0.002)
+
+    def pin(side, r=0.002):
+        tip = np.array([side * (R + h), 0.0, 0.0])
+        return Capsule(tuple(tip + side * np.array([r + 0.006, 0, 0])), tuple(tip + side * np.array([r, 0, 0])), r)
+    for kind, tip in (("pads", pad), ("pins", pin)):
+        progress(f"kernels: two {kind} with friction squeezing a sphere")
+        fingers = [FingerContact(tip(s), (-s, 0.0, 0.0), 0.5, offset=h, name=n) for s, n in ((1.0, "r"), (-1.0, "l"))]
+        terms = fingers + [FingerFriction(f, 0.5) for f in fingers]
+        if not solve_nonlinear(Problem(shell, terms, [RigidModes()]), PathOptions(steps=2)).completed:
+            raise RuntimeError(f"kernel workout: the {kind}' path stopped")
+
+
+def check_kernels(progress: Callable[[str], None] = lambda m: None) -> dict:
+    """Run :func:`kernel_workout`, recording the arguments of every ahead-of-time export, and
+    compare each export with numba's JIT build on them (which also leaves numba's on-disk cache
+    warm for those argument types).  Returns {"status": the ahead-of-time module's status line,
+    "records": :func:`graspdef.compiled.compare`'s, "missing": exports no call reached}."""
+    from . import compiled
+
+    exports = {k.export_name(i) for k in compiled.kernels() for i in range(len(k.signatures))}
+    if not compiled.aot_available():
+        return {"status": compiled.aot_status(), "records": [], "missing": sorted(exports)}
+    with compiled.recording() as rec:
+        kernel_workout(progress)
+    progress("kernels: each export against the JIT build")
+    return {"status": compiled.aot_status(), "records": compiled.compare(rec), "missing": sorted(exports - set(rec))}

@@ -6,7 +6,7 @@ A kernel is a plain Python function of arrays decorated with :func:`kernel` in o
 * the **ahead-of-time build** -- a C extension ``graspdef/_aot*.so`` that ``make setup`` compiles
   from the same sources with numba's ``pycc`` (``python -m graspdef.compiled``), serial -- when it
   exists, was built from the kernel sources as they are now (their SHA-256 is kept beside it, in
-  ``_aot.json``), holds the kernel for these argument types, and the call is small: a kernel that
+  ``_aot.json``) on this processor (it is compiled for the build machine's instruction set), holds the kernel for these argument types, and the call is small: a kernel that
   is parallel in the JIT build goes there only while its work (``args[work].shape[0]``) is at most
   :data:`SERIAL_MAX`;
 * otherwise the **JIT build**: numba's ``njit`` (``cache=True``, parallel where declared), which
@@ -29,6 +29,7 @@ numba's own dispatchers); nothing is compiled or loaded before the first call.
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib.util
 import importlib
@@ -58,6 +59,7 @@ prange = range
 
 _REGISTRY: dict[str, list["Kernel"]] = {}      # module name -> its kernels, in definition order
 _aot_state: dict = {}                          # "module": the loaded ahead-of-time module or None
+_recorder: dict | None = None                  # inside recording(): export name -> (kernel, export, args)
 
 
 class Kernel:
@@ -84,6 +86,8 @@ class Kernel:
     def __call__(self, *args):
         if self._aot is None:
             self._aot = _aot_exports(self)
+        if _recorder is not None:
+            _record(self, args)
         if self._aot and (not self.parallel or args[self.work].shape[0] <= SERIAL_MAX):
             for f, spec in self._aot:
                 if _matches(args, spec):
@@ -139,6 +143,21 @@ def _jit_module(name: str) -> None:
         k._jit = numba.njit(cache=True, parallel=k.parallel)(copy)
     for k in _REGISTRY.get(name, []):
         ns[k.__name__] = k._jit
+
+
+def cpu_name() -> str:
+    """This machine's processor model (the ahead-of-time module is compiled for the CPU it is built
+    on, like the JIT build, and is not used on another one)."""
+    import platform
+
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return f"{platform.machine()} {platform.processor()}".strip()
 
 
 def source_stamp() -> str:
@@ -219,6 +238,8 @@ def _aot_module():
         else:
             if stamp.get("source_sha256") != source_stamp():
                 _aot_state["why"] = "stale (built from other kernel sources)"
+            elif stamp.get("cpu") != cpu_name():
+                _aot_state["why"] = f"built for another processor ({stamp.get('cpu')})"
             else:
                 try:
                     _aot_state["module"] = importlib.import_module(f"graspdef.{AOT_NAME}")
@@ -228,6 +249,11 @@ def _aot_module():
         if _aot_state["module"] is None:
             log.debug("ahead-of-time kernels %s: the JIT build is used", _aot_state["why"])
     return _aot_state["module"]
+
+
+def aot_available() -> bool:
+    """Whether the ahead-of-time module is there, current and loadable."""
+    return _aot_module() is not None
 
 
 def aot_status() -> str:
@@ -245,6 +271,70 @@ def _signature(text: str):
     from numba.core import types
 
     return eval(text, {"__builtins__": {}}, dict(vars(types)))
+
+
+def _copy(a):
+    """A copy of a kernel argument that keeps an array's read-only flag (numba types read-only
+    arrays separately: the JIT build must see what the caller passed)."""
+    if isinstance(a, np.ndarray):
+        c = a.copy()
+        c.flags.writeable = a.flags.writeable
+        return c
+    return a
+
+
+def _record(k: Kernel, args) -> None:
+    for f, spec in k._aot or ():
+        name = getattr(f, "__name__", None) or repr(f)
+        if _matches(args, spec):
+            _recorder.setdefault(name, (k, f, tuple(_copy(a) for a in args)))
+            return
+
+
+@contextlib.contextmanager
+def recording():
+    """Within the block, the first arguments every ahead-of-time export would be (or is) given
+    are recorded (copied before the call); yields the dict export name -> (kernel, export, args)
+    that :func:`compare` checks."""
+    global _recorder
+    outer, _recorder = _recorder, {}
+    try:
+        yield _recorder
+    finally:
+        _recorder = outer
+
+
+def _same(a, b) -> bool:
+    """Equal to the bit (NaN equal to NaN): results of kernels (arrays, scalars, tuples, None)."""
+    if isinstance(a, tuple):
+        return isinstance(b, tuple) and len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    if isinstance(a, np.ndarray):
+        return (isinstance(b, np.ndarray) and a.dtype == b.dtype and a.shape == b.shape
+                and np.array_equal(a, b, equal_nan=a.dtype.kind in "fc"))
+    return a == b or (a != a and b != b)
+
+
+def compare(recorded: dict) -> list[dict]:
+    """Each recorded export run on its arguments and the JIT build on the same (fresh copies, so
+    that what a kernel writes into its arguments is compared too; the JIT build compiles, or loads
+    from numba's on-disk cache, the overload of those argument types).  One record per export:
+    name, kernel, ``equal`` (results and written arguments equal to the bit), the two builds'
+    seconds."""
+    import time
+
+    out = []
+    for name, (k, f, args) in sorted(recorded.items()):
+        a1, a2 = [_copy(a) for a in args], [_copy(a) for a in args]
+        k.jit(*[_copy(a) for a in args])                # compile / load before timing
+        t0 = time.perf_counter()
+        r1 = f(*a1)
+        t1 = time.perf_counter()
+        r2 = k.jit(*a2)
+        t2 = time.perf_counter()
+        out.append({"export": name, "kernel": f"{k.__module__}.{k.__name__}",
+                    "equal": _same(r1, r2) and all(_same(x, y) for x, y in zip(a1, a2)),
+                    "aot_s": t1 - t0, "jit_s": t2 - t1})
+    return out
 
 
 def builds_used() -> dict:
@@ -269,6 +359,7 @@ def build(out_dir: Path = _HERE, verbose: bool = False) -> Path:
         cc = CC(AOT_NAME)
         cc.output_dir = str(out_dir)
         cc.verbose = verbose
+        cc.target_cpu = "host"       # built where it runs (make setup): the machine's own instruction set, as the JIT
         exports = {}
         for name in KERNEL_MODULES:
             for k in _REGISTRY.get(name, []):
@@ -280,7 +371,7 @@ def build(out_dir: Path = _HERE, verbose: bool = False) -> Path:
         stamp_file.unlink(missing_ok=True)
         cc.compile()
     so = next(Path(out_dir).glob(f"{AOT_NAME}.*.so"))
-    stamp_file.write_text(json.dumps({"source_sha256": source_stamp(), "exports": exports}) + "\n")
+    stamp_file.write_text(json.dumps({"source_sha256": source_stamp(), "cpu": cpu_name(), "exports": exports}) + "\n")
     return so
 
 

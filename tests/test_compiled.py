@@ -6,14 +6,13 @@ The ahead-of-time module is built by ``make setup`` (``python -m graspdef.compil
 where it is missing or stale fails ``test_the_ahead_of_time_kernels_are_built_and_current``."""
 from __future__ import annotations
 
-import copy
 import json
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from graspdef import compiled
-from graspdef.compiled import Kernel
 
 ROOT = compiled._HERE.parent
 
@@ -36,85 +35,34 @@ def test_the_ahead_of_time_kernels_are_built_and_current():
     assert want and set(stamp["exports"]) == want
 
 
-def _record(monkeypatch) -> dict:
-    """Wrap Kernel.__call__: the first arguments of every ahead-of-time export that a call would
-    use, copied before the call (the kernels write into some of them)."""
-    seen: dict = {}
-    call = Kernel.__call__
+def test_every_ahead_of_time_kernel_gives_the_jit_builds_numbers_to_the_bit():
+    """``graspdef bench kernels`` (graspdef.bench.check_kernels): on the arguments that small real
+    solves give them (a linear plate, a neo-Hookean ball with gas, pads and pins with friction),
+    each export's result and everything it writes into its arguments equal the JIT build's exactly
+    (serial against parallel, pycc against JIT: no reductions across a parallel loop, no fastmath);
+    every export is reached."""
+    from graspdef.bench import check_kernels
 
-    def recording(self, *args):
-        if self._aot is None:
-            self._aot = compiled._aot_exports(self)
-        for i in range(len(self.signatures)):
-            name = self.export_name(i)
-            spec = compiled._aot_state.get("exports", {}).get(name)
-            if name not in seen and spec is not None and compiled._matches(args, spec):
-                seen[name] = (self, getattr(compiled._aot_module(), name), copy.deepcopy(args))
-                break
-        return call(self, *args)
-    monkeypatch.setattr(Kernel, "__call__", recording)
-    return seen
+    out = check_kernels()
+    assert out["status"].startswith("ahead-of-time kernels in use"), out["status"]
+    assert out["missing"] == [], "exports no solve reached: " + ", ".join(out["missing"])
+    assert len(out["records"]) == len({k.export_name(i) for k in compiled.kernels() for i in range(len(k.signatures))})
+    assert [r["export"] for r in out["records"] if not r["equal"]] == []
 
 
-def _same(a, b) -> bool:
-    if isinstance(a, tuple):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
-    if isinstance(a, np.ndarray):
-        return a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b, equal_nan=a.dtype.kind == "f")
-    return (a == b) or (a != a and b != b)
+def test_compare_finds_a_difference():
+    """The comparison can fail: an export recorded with the arguments of one call but compared with
+    a JIT build that computes something else (here: another kernel of the same arguments' types)."""
+    from graspdef.solve._kernels import kkt_upper_values
 
-
-def _cases():
-    """Real solves that call every exported kernel: the linear plate (patterns, strains, the shell's
-    assembly, the KKT matrix), a neo-Hookean ball holding gas (densities, enclosed volume) and two
-    pads squeezing a sphere with friction (box distances, the contact samples' gather/scatter and Hessian)."""
-    from graspdef.contact.barrier import FingerContact, RoundedBox
-    from graspdef.contact.friction import FingerFriction
-    from graspdef.geometry import icosphere
-    from graspdef.problem.config import load_problem
-    from graspdef.problem.loads import PointLoad
-    from graspdef.problem.potentials import EnclosedGas
-    from graspdef.problem.problem import Problem
-    from graspdef.problem.supports import RigidModes
-    from graspdef.shell.hyperelastic import NeoHookean
-    from graspdef.shell.materials import LinearElastic
-    from graspdef.shell.model import Shell
-    from graspdef.solve.linear import solve_linear
-    from graspdef.solve.nonlinear import PathOptions, solve_nonlinear
-
-    solve_linear(load_problem(ROOT / "benchmarks" / "plate_ss_uniform.toml").problem)
-    R, t = 0.0325, 0.0025
-    m = icosphere(radius=R, subdivisions=2)
-    pr = Problem(Shell(m.vertices, m.faces, NeoHookean(1e6 / 3), t), [EnclosedGas(8e4)], [RigidModes()])
-    top, bot = pr.locate((0, 0, R)), pr.locate((0, 0, -R))
-    pr.loads += [PointLoad(top.face, top.bary, (0, 0, -2.0)), PointLoad(bot.face, bot.bary, (0, 0, 2.0))]
-    assert solve_nonlinear(pr, PathOptions(steps=2)).completed
-    shell = Shell(m.vertices, m.faces, LinearElastic(1e6, 0.45), 0.002)
-
-    def pad(side):
-        c = np.array([side * (R + 0.001 + 0.002), 0.0, 0.0])
-        return RoundedBox(tuple(c), tuple(map(tuple, np.eye(3))), (0.002, 0.008, 0.008), 0.002)
-    fingers = [FingerContact(pad(s), (-s, 0.0, 0.0), 0.5, offset=0.001, name=n) for s, n in ((1.0, "r"), (-1.0, "l"))]
-    friction = [FingerFriction(f, 0.5) for f in fingers]
-    assert solve_nonlinear(Problem(shell, fingers + friction, [RigidModes()]), PathOptions(steps=2)).completed
-
-
-def test_every_ahead_of_time_kernel_gives_the_jit_builds_numbers_to_the_bit(monkeypatch, fresh_state):
-    """On the inputs of real solves (``_cases``), each export's result and everything it writes
-    into its arguments equal the JIT build's exactly (serial against parallel, pycc against JIT:
-    no reductions across a parallel loop, no fastmath).  Every export must be called by a case."""
-    if compiled._aot_module() is None:
-        pytest.fail(compiled.aot_status())
-    monkeypatch.setattr(compiled, "SERIAL_MAX", 10**9)
-    seen = _record(monkeypatch)
-    _cases()
-    assert set(seen) == set(compiled._aot_state["exports"]), "exports no case calls: " + \
-        ", ".join(sorted(set(compiled._aot_state["exports"]) - set(seen)))
-    for name, (k, aot, args) in sorted(seen.items()):
-        a1, a2 = copy.deepcopy(args), copy.deepcopy(args)
-        r1, r2 = aot(*a1), k.jit(*a2)
-        assert _same(r1, r2), name
-        assert all(_same(x, y) for x, y in zip(a1, a2)), f"{name}: its outputs written into arguments differ"
+    src, kd, cd = np.array([1, 0, -1], np.int64), np.array([5.0, 6.0]), np.array([7.0])
+    with compiled.recording() as rec:
+        kkt_upper_values(src, kd, cd, 2.0)
+    (name, (k, f, args)), = rec.items()
+    assert compiled.compare(rec)[0]["equal"]
+    other = SimpleNamespace(jit=lambda s, a, b, c: np.ones(len(s)), __module__="x", __name__="ones")
+    rec[name] = (other, f, args)
+    assert not compiled.compare(rec)[0]["equal"]
 
 
 def test_arguments_of_other_types_go_to_the_jit_build(fresh_state):
@@ -158,3 +106,22 @@ def test_a_run_folder_records_which_builds_ran(tmp_path):
     k = read_provenance(write_provenance(tmp_path).parent)["kernels"]
     assert k["ahead_of_time"] == compiled.aot_status() and k["ahead_of_time"].startswith("ahead-of-time kernels in use")
     assert set(k["jit"]) <= set(compiled.KERNEL_MODULES)
+
+
+def test_a_module_built_for_another_processor_is_not_used(monkeypatch, fresh_state):
+    """The module is compiled for the build machine's instruction set: on another processor model
+    (a shared disk) it is not loaded, and the status says so."""
+    monkeypatch.setattr(compiled, "cpu_name", lambda: "some other processor")
+    assert compiled._aot_module() is None
+    assert "another processor" in compiled.aot_status()
+
+
+def test_bench_kernels_without_the_module_is_one_line(monkeypatch, fresh_state, capsys):
+    """``graspdef bench kernels`` where the module is stale: exit status 2 and one line that says
+    why and how to build it."""
+    from graspdef.cli import main
+
+    monkeypatch.setattr(compiled, "source_stamp", lambda: "0" * 64)
+    assert main(["-q", "bench", "kernels"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "stale" in err[0] and "python -m graspdef.compiled" in err[0], err

@@ -58,7 +58,7 @@ def box_distance(P, shift, c, R, h, rounding, e):
     return phi, n, d1, d2
 
 
-@kernel()
+@kernel(aot=("Tuple((f8[::1], f8[:,::1], f8[::1], f8[::1]))(f8[:,::1], f8[::1], f8[::1], f8[::1], f8, f8[::1])",))
 def capsule_distance(P, shift, a, b, radius, e):
     """Capsule (segment a-b, radius): phi (k,), outward unit normal n (k, 3), and along the unit
     vector e the derivatives of phi(p - s e) in s: -n.e (k,) and e.H.e (k,)."""
