@@ -31,6 +31,18 @@ it first thing, before any solve (it only helps speed, never changes a result):
   others it must be set before numpy is first imported (the command line calls configure before
   any numerical import; ``blas_threads_fixed`` in the returned dict says whether it was in time).
 
+* **MKL's threading layer.**  MKL's single runtime library (``libmkl_rt``, what pypardiso loads)
+  chooses its OpenMP runtime when it starts; PARDISO's numbers then depend, at round-off level, on
+  whether GNU OpenMP (numba's) was already loaded: the free-edge pull-out's linear solve came out
+  with different last bits in a process whose kernels ran ahead of time (graspdef.compiled: no
+  numba, no GNU OpenMP) and in one that had run numba's parallel kernels first, and with
+  ``MKL_THREADING_LAYER=GNU`` the two are equal to the bit.  ``MKL_THREADING_LAYER=GNU`` is set
+  unless the user has set it: one OpenMP runtime (GNU's, numba's) in every process, and the same
+  PARDISO numbers whichever build of the kernels ran.  Speed unchanged (2026-11-27: the 1,681-vertex
+  plate 0.76-0.94 s whole process against 0.86-0.99 s, the 10k pinched cylinder's assembly + solve
+  1.21 / 1.27 s against 1.38 / 1.21 s, alternating).  Like the others it must be set before MKL
+  loads (the first PARDISO solve).
+
 * **MuJoCo's OpenGL.**  ``import mujoco`` loads its classic renderer and an OpenGL context
   module (GLFW) unless ``MUJOCO_GL`` says rendering is disabled; graspdef uses MuJoCo for physics
   only and never renders with it.  ``MUJOCO_GL=disable`` is set unless the user has set it:
@@ -57,13 +69,14 @@ def locate_mkl_rt() -> str | None:
 
 
 def configure() -> dict:
-    """Set the OpenMP wait policy, numba's threading layer, OpenBLAS's thread count and MuJoCo's
-    OpenGL (unless set) and locate MKL's runtime; returns what is in effect."""
+    """Set the OpenMP wait policy, numba's and MKL's threading layers, OpenBLAS's thread count and
+    MuJoCo's OpenGL (unless set) and locate MKL's runtime; returns what is in effect."""
     os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
     os.environ.setdefault("NUMBA_THREADING_LAYER", "omp")
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     os.environ.setdefault("MUJOCO_GL", "disable")
-    return {"OMP_WAIT_POLICY": os.environ["OMP_WAIT_POLICY"], "NUMBA_THREADING_LAYER": os.environ["NUMBA_THREADING_LAYER"],
+    os.environ.setdefault("MKL_THREADING_LAYER", "GNU")
+    return {"MKL_THREADING_LAYER": os.environ["MKL_THREADING_LAYER"], "OMP_WAIT_POLICY": os.environ["OMP_WAIT_POLICY"], "NUMBA_THREADING_LAYER": os.environ["NUMBA_THREADING_LAYER"],
             "OPENBLAS_NUM_THREADS": os.environ["OPENBLAS_NUM_THREADS"], "blas_threads_fixed": "numpy" not in sys.modules,
             "MUJOCO_GL": os.environ["MUJOCO_GL"], "PYPARDISO_MKL_RT": locate_mkl_rt()}
 

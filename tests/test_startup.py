@@ -168,6 +168,19 @@ def test_lazy_imports_change_no_number(lazy_plate, tmp_path):
     assert (out / "deformed.ply").read_bytes() == (tmp_path / "eager" / "deformed.ply").read_bytes()
 
 
+def test_both_kernel_builds_give_the_same_plate_to_the_bit(lazy_plate, tmp_path):
+    """The plate in a process whose kernels ran ahead of time (no numba, no GNU OpenMP; lazy_plate)
+    and in one forced onto numba's parallel JIT build first (GNU OpenMP loaded before MKL): the same
+    result to the bit (both single-threaded).  The kernels agree to the bit (tests/test_compiled.py);
+    PARDISO did not until runtime.configure fixed MKL's threading layer (MKL_THREADING_LAYER=GNU):
+    with MKL choosing by itself, the free-edge pull-out's solution differed in its last bits."""
+    out, _, lazy = lazy_plate
+    loaded, jit = _solve_plate(tmp_path / "jit", preload="import graspdef.compiled as c\nc.SERIAL_MAX = -1")
+    assert lazy["derived"]["max_displacement"] == jit["derived"]["max_displacement"]
+    assert lazy["probes"] == jit["probes"]
+    assert (out / "deformed.ply").read_bytes() == (tmp_path / "jit" / "deformed.ply").read_bytes()
+
+
 def _fresh_json(code: str, unset: str, extra: dict | None = None):
     """Run ``code`` in a fresh interpreter with the environment variable ``unset`` removed (and
     ``extra`` added); returns the JSON of its last printed line."""
