@@ -21,8 +21,10 @@ faster), where numba's fixed cost is small against the solve.
 
 Both builds compute the same numbers: the kernels' parallel loops write disjoint outputs (no
 reductions across iterations) and nothing is compiled with fastmath, so serial and parallel,
-ahead-of-time and JIT agree to the bit (``tests/test_compiled.py`` checks it).  A missing or
-stale ahead-of-time module only costs speed: the JIT build is used, never old code.
+ahead-of-time and JIT agree to the bit (``tests/test_compiled.py`` and ``graspdef bench kernels``
+check it on real solves' arguments; a whole solve agrees to the bit too once MKL's threading layer
+is fixed, graspdef.runtime).  A missing, stale or foreign (another processor's) ahead-of-time
+module only costs speed: the JIT build is used, never old code.
 
 :func:`kernel`'s registry is filled at import by the kernel modules' decorators (static, like
 numba's own dispatchers); nothing is compiled or loaded before the first call.
