@@ -40,7 +40,9 @@ it first thing, before any solve (it only helps speed, never changes a result):
   unless the user has set it: one OpenMP runtime (GNU's, numba's) in every process, and the same
   PARDISO numbers whichever build of the kernels ran.  Speed unchanged (2026-11-27: the 1,681-vertex
   plate 0.76-0.94 s whole process against 0.86-0.99 s, the 10k pinched cylinder's assembly + solve
-  1.21 / 1.27 s against 1.38 / 1.21 s, alternating).  Like the others it must be set before MKL
+  1.21 / 1.27 s against 1.38 / 1.21 s, alternating; its refactorisation after numba's parallel
+  assembly 0.583 / 0.569 / 0.612 s against 0.590 / 0.554 / 0.610 s, medians of 8 in 3 processes
+  each).  Like the others it must be set before MKL
   loads (the first PARDISO solve).
 
 * **MuJoCo's OpenGL.**  ``import mujoco`` loads its classic renderer and an OpenGL context
