@@ -287,9 +287,8 @@ def _copy(a):
 
 def _record(k: Kernel, args) -> None:
     for f, spec in k._aot or ():
-        name = getattr(f, "__name__", None) or repr(f)
         if _matches(args, spec):
-            _recorder.setdefault(name, (k, f, tuple(_copy(a) for a in args)))
+            _recorder.setdefault(f.__name__, (k, f, tuple(_copy(a) for a in args)))
             return
 
 

@@ -125,3 +125,20 @@ def test_bench_kernels_without_the_module_is_one_line(monkeypatch, fresh_state, 
     assert main(["-q", "bench", "kernels"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "stale" in err[0] and "python -m graspdef.compiled" in err[0], err
+
+
+def test_bench_kernels_writes_its_folder_and_refuses_options_it_ignores(tmp_path, capsys):
+    """``--out DIR``: kernels.json (every export equal) and provenance.json; ``--only`` and ``--dir``
+    (which select benchmark files) are one-line errors, exit 2, nothing written."""
+    from graspdef.cli import main
+
+    assert main(["-q", "bench", "kernels", "--out", str(tmp_path / "k")]) == 0
+    rec = json.loads((tmp_path / "k" / "kernels.json").read_text())
+    assert rec["records"] and all(r["equal"] for r in rec["records"]) and rec["missing"] == []
+    assert (tmp_path / "k" / "provenance.json").is_file()
+    for extra in (["--only", "plate*"], ["--dir", str(tmp_path)]):
+        capsys.readouterr()
+        assert main(["-q", "bench", "kernels", "--out", str(tmp_path / "x"), *extra]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and extra[0] in err[0], err
+        assert not (tmp_path / "x").exists()

@@ -1,4 +1,4 @@
-"""``graspdef bench linear|nonlinear|axisym [--json FILE] [--out DIR]``: run a benchmark set."""
+"""``graspdef bench linear|nonlinear|axisym|kernels [--json FILE] [--out DIR]``: run a benchmark set."""
 from __future__ import annotations
 
 import argparse
@@ -66,16 +66,27 @@ def _kernels(args: argparse.Namespace, say) -> int:
     from ..bench import check_kernels
     from ..errors import ProblemError
 
+    for flag, value in (("--dir", args.dir), ("--only", None if args.only == "*" else args.only)):
+        if value is not None:
+            raise ProblemError(f"bench kernels: {flag} does not apply (it runs its own small solves)")
     out = check_kernels(progress=say)
-    print(out["status"])
     if not out["records"] and out["missing"]:
         raise ProblemError(out["status"])
+    print(out["status"])
     for r in out["records"]:
         print(f"{'equal' if r['equal'] else 'DIFFERENT':9s}  {r['export']:45s} ahead of time {r['aot_s'] * 1e3:8.2f} ms"
               f"   JIT {r['jit_s'] * 1e3:8.2f} ms")
     if args.json:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
         Path(args.json).write_text(json.dumps(out, indent=2) + "\n")
+    if args.out:
+        from ..runs.folder import atomic_folder
+        from ..runs.provenance import write_provenance
+
+        with atomic_folder(args.out) as tmp:
+            (tmp / "kernels.json").write_text(json.dumps(out, indent=2) + "\n")
+            write_provenance(tmp, {"set": "kernels"})
+        say(f"wrote {args.out}/ (kernels.json, provenance.json)")
     bad = [r["export"] for r in out["records"] if not r["equal"]]
     if bad or out["missing"]:
         say(f"differ from the JIT build: {', '.join(bad) or 'none'}; not reached: {', '.join(out['missing']) or 'none'}")
