@@ -63,6 +63,10 @@ class PathStopped(SolverError):
 #: a step that approaches a limit point aims this fraction of the way to its estimated load
 FOLD_SHORT = 0.9
 
+#: where a bisection step that locates a change of stability tries its point, as fractions of
+#: the bracket from its stable end, in this order (:meth:`PathSolver._locate`)
+LOCATE_SPLITS = (0.5, 0.25, 0.75)
+
 
 def fold_estimate(lam1: float, n1: float, lam2: float, n2: float) -> float | None:
     """The load factor of a limit point ahead, from the tangent norms n = |du/dlam| at two
@@ -783,7 +787,7 @@ class PathSolver:
             self._check_spurious(last, inst, lam, u_new, lam_new)
             pt = self._record(u_new, lam_new, st, its, inst, "target" if is_target and nxt != lam_end else "step")
             if opt.bifurcation != "report" and last is not None and inst is not None and inst != last:
-                refined, crit = self._locate(u, lam, u_new, lam_new, last)
+                refined, crit = self._locate(sol, u, lam, u_new, lam_new, last)
                 sol.path += refined
                 if opt.bifurcation == "switch" and crit is not None and not self.switched:
                     self.switched = True
@@ -918,7 +922,7 @@ class PathSolver:
             last = sol.path[-1].instability
             self._check_spurious(last, inst, lam, u_new, lam_new)
             if opt.refine_critical and last is not None and inst is not None and inst != last and mode is None:
-                sol.path += self._bracket(u, lam, dl, du_prev, dlam_prev, last)
+                sol.path += self._bracket(sol, u, lam, dl, du_prev, dlam_prev, last)
             pt = self._record(u_new, lam_new, st, its, inst, "step" if mode is None else "branch")
             mode = None
             sol.path.append(pt)
@@ -932,17 +936,28 @@ class PathSolver:
                                min(dl * opt.max_growth, dl_max)))
         raise _Failed(f"the path needed more than max_steps={opt.max_steps} steps (reached load factor {lam:.6g})")
 
-    def _locate(self, u_a, lam_a, u_b, lam_b, inst_a):
+    def _locate(self, sol, u_a, lam_a, u_b, lam_b, inst_a):
         """Bisect the load step from the converged (u_a, lam_a) (instability inst_a) to (u_b, lam_b)
         (another instability) ``refine_critical`` times; returns the new path points in load order
-        and (u, lam) of the point past the change closest to it (None if no bisection converged)."""
+        and (u, lam) of the point past the change closest to it ((u_b, lam_b) if no bisection
+        converged).  A bracket that could not be narrowed further is an event of ``sol``."""
         a_side, b_side = [], []
         crit = (u_b, lam_b)
         for _ in range(self.opt.refine_critical):
-            lam_m = 0.5 * (lam_a + lam_b)
-            try:
-                u_m, st, its, inst = self.newton(0.5 * (u_a + u_b), lam_m)
-            except (_Failed, SolverError):
+            # the midpoint; where Newton fails there (the tangent is nearly singular at a
+            # critical load: a perfect sphere under pressure loses stability in 2l+1 modes at
+            # once), a quarter of the way in from either end
+            for frac in LOCATE_SPLITS:
+                lam_m = (1 - frac) * lam_a + frac * lam_b
+                try:
+                    u_m, st, its, inst = self.newton((1 - frac) * u_a + frac * u_b, lam_m)
+                    break
+                except (_Failed, SolverError) as exc:
+                    why = str(exc)
+            else:
+                sol.events.append({"from_load_factor": float(lam_a), "to_load_factor": float(lam_b),
+                                   "action": "critical point's bracket not narrowed further",
+                                   "reason": f"no equilibrium found inside it ({why})"})
                 break
             pt = self._record(u_m, lam_m, st, its, inst, "refine")
             if inst == inst_a:
@@ -1039,24 +1054,35 @@ class PathSolver:
                 break
         return v
 
-    def _bracket(self, u, lam, dl, du_prev, dlam_prev, inst_a):
+    def _bracket(self, sol, u, lam, dl, du_prev, dlam_prev, inst_a):
         """Bisect the arc length from the stable side (u, lam) towards a change of stability;
-        returns the new path points in path order (stable side first)."""
+        returns the new path points in path order (stable side first).  Where the corrector fails
+        at the middle of the bracket, a quarter of the way in from either end is tried
+        (``LOCATE_SPLITS``, as in :meth:`_locate`); a bracket that cannot be narrowed further is an
+        event of ``sol``."""
         a_side, b_side = [], []
-        dlc = dl
+        w = dl                                       # the bracket's arc length from (u, lam)
         for _ in range(self.opt.refine_critical):
-            dlc /= 2
-            try:
-                uh, lh, ih, sth, insth = self._arc_step(u, lam, dlc, du_prev, dlam_prev)
-            except (_Failed, SolverError):
+            for frac in LOCATE_SPLITS:
+                try:
+                    uh, lh, ih, sth, insth = self._arc_step(u, lam, frac * w, du_prev, dlam_prev)
+                    break
+                except (_Failed, SolverError) as exc:
+                    why = str(exc)
+            else:
+                sol.events.append({"from_load_factor": float(lam), "arc_length": float(w),
+                                   "action": "critical point's bracket not narrowed further",
+                                   "reason": f"no equilibrium found inside it ({why})"})
                 break
             pt = self._record(uh, lh, sth, ih, insth, "refine")
             if insth == inst_a:
                 a_side.append(pt)
                 self.eq.commit(uh)
                 du_prev, dlam_prev, u, lam = uh - u, lh - lam, uh, lh
+                w *= 1 - frac
             else:
                 b_side.append(pt)
+                w *= frac
         return a_side + b_side[::-1]
 
     def _arc_step(self, u, lam, dl, du_prev, dlam_prev):

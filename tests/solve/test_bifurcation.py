@@ -78,3 +78,97 @@ def test_branch_switch_follows_the_elastica():
 def test_bifurcation_option_is_checked():
     with pytest.raises(ProblemError, match="bifurcation must be one of"):
         PathOptions(bifurcation="jump")
+
+
+
+def _step_bracket():
+    """The load step across Euler's load on the path to 1.2 in 10 initial steps (the steps grow:
+    0.12, 0.36, 0.84, then 1.2): its two path points' load factors."""
+    sol = solve_nonlinear(strip(), PathOptions(max_load=1.2, steps=10))
+    lam = [p.load_factor for p in sol.path]
+    k = next(i for i, p in enumerate(sol.path) if p.instability == 1)
+    return lam[k - 1], lam[k]
+
+
+def _failing_at(monkeypatch, loads):
+    """Newton made to fail at the given load factors (to 1e-12 relative): a nearly singular tangent
+    at a critical load does this (a perfect sphere under external pressure at p_cl loses stability
+    in 2l + 1 modes at once)."""
+    import graspdef.solve.nonlinear as nl
+
+    newton = nl.PathSolver.newton
+
+    def failing(self, u0, lam, *args, **kwargs):
+        if any(abs(lam - x) <= 1e-12 * abs(x) for x in loads):
+            raise nl._Failed(f"injected failure at load factor {lam:.6g}")
+        return newton(self, u0, lam, *args, **kwargs)
+
+    monkeypatch.setattr(nl.PathSolver, "newton", failing)
+
+
+def test_locate_steps_aside_where_the_midpoint_fails(monkeypatch):
+    """Where Newton fails at the first bisection point of Euler's bracket [a, b] (its midpoint),
+    the point a quarter of the way in from the stable end is taken instead, and the bracket still
+    narrows to within 3e-4 of P_cr at both ends (measured [0.999854, 0.999985], against [0.999941,
+    1.000029] without the failure: each point's inertia comes from a tangent factorised within
+    inertia_rtol = 1e-4 of equilibrium, which blurs the change of sign at that level; before, the
+    bisection stopped at the first failure and left [a, b] = [0.84, 1.2], without a word)."""
+    a, b = _step_bracket()
+    _failing_at(monkeypatch, [0.5 * (a + b)])
+    sol = solve_nonlinear(strip(), PathOptions(max_load=1.2, steps=10, bifurcation="locate"))
+    (cp,) = sol.critical_points
+    lo, hi = cp["bracket"]
+    assert 1.0 - 3e-4 < lo < hi < 1.0 + 3e-4, (lo, hi)
+    assert any(abs(p.load_factor - (0.75 * a + 0.25 * b)) < 1e-12 and p.kind == "refine" for p in sol.path)
+    assert not any("bracket" in e.get("action", "") for e in sol.events)
+
+
+def test_locate_reports_a_bracket_it_cannot_narrow(monkeypatch):
+    """Where Newton fails at every trial point of a bisection step (the midpoint and the quarter
+    points), the bracket stays [a, b] and the path's events say so."""
+    a, b = _step_bracket()
+    _failing_at(monkeypatch, [0.5 * (a + b), 0.75 * a + 0.25 * b, 0.25 * a + 0.75 * b])
+    sol = solve_nonlinear(strip(), PathOptions(max_load=1.2, steps=10, bifurcation="locate"))
+    (cp,) = sol.critical_points
+    assert cp["bracket"] == pytest.approx([a, b], rel=1e-12)
+    (ev,) = [e for e in sol.events if "bracket" in e.get("action", "")]
+    assert (ev["from_load_factor"], ev["to_load_factor"]) == pytest.approx((a, b), rel=1e-12)
+    assert "injected failure" in ev["reason"]
+
+
+def test_arc_length_bracket_steps_aside_where_the_middle_fails(monkeypatch):
+    """The same for the arc-length path (to 2 P_cr in 20 initial steps; its bracket across Euler's
+    load is bisected in arc length): where the corrector fails at the first bisection point, a
+    quarter of the way in is tried, and the bracket still narrows to within 3e-4 of P_cr (measured
+    [0.99994, 1.00014] without the failure); where it fails at all three, the path's events say so."""
+    import graspdef.solve.nonlinear as nl
+
+    opts = PathOptions(method="arc_length", max_load=2.0, steps=20)
+    bracket, arc_step = nl.PathSolver._bracket, nl.PathSolver._arc_step
+    for fails in (1, 3):
+        calls = []
+
+        def in_bracket(self, *args, **kwargs):
+            calls.append(0)                     # from now on, count the corrector's attempts
+            return bracket(self, *args, **kwargs)
+
+        def failing(self, *args, **kwargs):
+            if calls:
+                calls.append(1)
+                if len(calls) <= 1 + fails:
+                    raise nl._Failed("injected failure")
+            return arc_step(self, *args, **kwargs)
+
+        monkeypatch.setattr(nl.PathSolver, "_bracket", in_bracket)
+        monkeypatch.setattr(nl.PathSolver, "_arc_step", failing)
+        sol = solve_nonlinear(strip(), opts)
+        (cp,) = sol.critical_points
+        lo, hi = cp["bracket"]
+        events = [e for e in sol.events if "bracket" in e.get("action", "")]
+        if fails == 1:
+            assert 1.0 - 3e-4 < lo < hi < 1.0 + 3e-4, (lo, hi)
+            assert not events
+        else:
+            assert hi - lo > 0.5 and lo < 1.0 < hi           # the step's own ends, [0.7, 1.5]
+            (ev,) = events
+            assert "injected failure" in ev["reason"]
