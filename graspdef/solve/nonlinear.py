@@ -903,7 +903,10 @@ class PathSolver:
                                    "action": "arc length halved", "reason": str(exc)})
                 dl /= 2
                 continue
-            # requested load levels crossed by this step: land on them exactly
+            # requested load levels crossed by this step: land on them exactly.  A change of
+            # stability between the path's last point and a landed level (or the step's end) is
+            # checked and narrowed down between those two points, by arc length from the first
+            prev = None                                   # (u, lam) of the last level landed on
             crossed = [s for s in targets if (s - lam) * (s - lam_new) <= 0 and s != lam]
             for s in sorted(crossed, key=lambda v: abs(v - lam)):
                 w = (s - lam) / (lam_new - lam)
@@ -913,16 +916,29 @@ class PathSolver:
                     log.info("could not land on load factor %.6g (%s)", s, exc)
                     continue
                 pt = self._record(u_t, s, st_t, its_t, inst_t, "target")
+                last = sol.path[-1].instability
+                u_a, lam_a = prev if prev is not None else (u, lam)
+                self._check_spurious(last, inst_t, lam_a, u_t, s)
+                if opt.refine_critical and last is not None and inst_t is not None and inst_t != last \
+                        and mode is None:
+                    sol.path += self._bracket(sol, u_a, lam_a, float(np.linalg.norm(u_t - u_a)), u_t - u_a,
+                                              s - lam_a, last)
                 sol.path.append(pt)
                 self._emit(sol, pt, dl)
                 if abs(s - lam_end) <= 1e-12 * abs(lam_end):
                     pt.kind = "step"
                     self.eq.commit(u_t)
                     return
+                prev = (u_t, s)
             last = sol.path[-1].instability
-            self._check_spurious(last, inst, lam, u_new, lam_new)
+            self._check_spurious(last, inst, lam if prev is None else prev[1], u_new, lam_new)
             if opt.refine_critical and last is not None and inst is not None and inst != last and mode is None:
-                sol.path += self._bracket(sol, u, lam, dl, du_prev, dlam_prev, last)
+                if prev is None:
+                    sol.path += self._bracket(sol, u, lam, dl, du_prev, dlam_prev, last)
+                else:
+                    u_a, lam_a = prev
+                    sol.path += self._bracket(sol, u_a, lam_a, float(np.linalg.norm(u_new - u_a)), u_new - u_a,
+                                              lam_new - lam_a, last)
             pt = self._record(u_new, lam_new, st, its, inst, "step" if mode is None else "branch")
             mode = None
             sol.path.append(pt)

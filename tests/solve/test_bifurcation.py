@@ -172,3 +172,34 @@ def test_arc_length_bracket_steps_aside_where_the_middle_fails(monkeypatch):
             assert hi - lo > 0.5 and lo < 1.0 < hi           # the step's own ends, [0.7, 1.5]
             (ev,) = events
             assert "injected failure" in ev["reason"]
+
+
+def test_arc_length_path_narrows_a_change_in_its_last_step():
+    """An arc-length path whose stability changes in the step that lands on its end (to 1.2 P_cr in
+    10 steps: the last from 0.84 to 1.2) narrows that change down like any other (before: it landed
+    and returned, the bracket [0.84, 1.2] and the spurious-mode check skipped; measured now
+    [0.99994, 1.00003])."""
+    sol = solve_nonlinear(strip(), PathOptions(method="arc_length", max_load=1.2, steps=10))
+    assert sol.completed and sol.path[-1].load_factor == pytest.approx(1.2)
+    (cp,) = sol.critical_points
+    lo, hi = cp["bracket"]
+    assert 1.0 - 3e-4 < lo < hi < 1.0 + 3e-4, (lo, hi)
+    lam = sol.load_factors()
+    assert np.all(np.diff(lam) > 0)                  # the refined points lie in path order
+
+
+@pytest.mark.parametrize("targets", [(0.95, 1.05, 1.3), (0.95,), (1.05,)])
+def test_arc_length_path_narrows_a_change_between_requested_levels(targets):
+    """Requested load levels landed on inside the arc-length step that crosses Euler's load (to
+    2 P_cr in 20 steps: the step from 0.70 to 1.50) no longer hide the change: it is narrowed down
+    between the path point and the level (or the step's end) that enclose it (before: with levels
+    0.95, 1.05 and 1.3 the bracket stayed [0.95, 1.05] and no point was refined; measured now
+    [0.99998, 1.0], [0.99994, 1.00007] and [0.99992, 1.00001])."""
+    sol = solve_nonlinear(strip(), PathOptions(method="arc_length", max_load=2.0, steps=20, targets=targets))
+    assert sol.completed
+    (cp,) = sol.critical_points
+    lo, hi = cp["bracket"]
+    assert 1.0 - 3e-4 < lo < hi < 1.0 + 3e-4, (lo, hi)
+    assert np.all(np.diff(sol.load_factors()) > 0)
+    for lam in targets:
+        assert sol.at(lam).kind == "target"
