@@ -19,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import logging
+import math
 import os
 import shutil
 import tempfile
@@ -160,6 +161,7 @@ class KKTSystem:
         self._ooc_dir: str | None = None  # pardiso-ooc: the folder of PARDISO's factor files
         self.ooc_core_mb = OOC_CORE_MB    # pardiso-ooc: the factor's part held in memory [MB]
         self._ooc_threads: int | None = None   # pardiso-ooc: MKL's thread count, fixed at the first call
+        self.ooc_retries = 0              # pardiso-ooc: factorisations refused for too little memory (error -9)
         self.C = C.tocsr()
         self.m = self.C.shape[0]
         self._solver = None
@@ -260,19 +262,24 @@ class KKTSystem:
         s._check_A(U)
         z = np.zeros((U.shape[0], 1))
         try:
-            with self._ooc_environment():
-                if analyse or new_pattern:
+            if analyse or new_pattern:
+                with self._ooc_environment():
                     s.set_phase(11)                     # analysis (matching, ordering)
                     s._call_pardiso(U, z)
-                    self._map = upper_map               # kept once PARDISO has analysed it
+                self._map = upper_map                   # kept once PARDISO has analysed it
+                if self._ooc_dir is not None:
+                    self._fit_ooc_core(int(s.get_iparm(61)))
+            with self._ooc_environment():
                 s.set_phase(22)                         # numerical factorisation
                 s._call_pardiso(U, z)
         except Exception as exc:
             if self._ooc_dir is None or getattr(exc, "value", None) != -9:
                 raise
             # -9: the in-memory part allowed is below what PARDISO's out-of-core mode needs for this
-            # matrix (the 100k pinched cylinder: between 600 and 800 MB): double it, analyse again
+            # matrix although its analysis said otherwise (_fit_ooc_core; not seen since): double
+            # it, analyse again
             self.close()
+            self.ooc_retries += 1
             self.ooc_core_mb *= 2
             have = _available_mb()
             if have is not None and self.ooc_core_mb > have:
@@ -286,6 +293,27 @@ class KKTSystem:
         self._U = U
         self.perturbed = int(s.get_iparm(14))
         self.n_negative = int(s.get_iparm(23))
+
+    def _fit_ooc_core(self, need_kb: int) -> None:
+        """pardiso-ooc, after an analysis: raise the factor's part held in memory to what PARDISO's
+        out-of-core factorisation needs for this matrix, as its analysis reports it (iparm 61, in KB)
+        with OOC_CORE_MARGIN, so that the factorisation does not fail with error -9.  Measured, the
+        least size that factorises (in MB) is that number rounded up: 40 x 40 plate 12,465 KB, 12 MB
+        fails, 13 MB factorises; the 10k pinched cylinder 68,840 KB, 67 MB fails, 68 MB factorises
+        (iparm 62, 9,429 and 43,260 KB, is not it).  Before 2026-11-27 the error itself was the
+        signal: the system was closed, the memory doubled and the matrix analysed again -- and a
+        solver re-created after that failure came out wrong in 3 of 260 processes (a solution 1 %
+        off SuperLU's at a residual of 1e-12, a solve failing its check, a process ending without
+        output), against 0 of 120 without the failure (README, "Out of core")."""
+        need_mb = math.ceil(need_kb * OOC_CORE_MARGIN / 1024)
+        if need_kb <= 0 or self.ooc_core_mb >= need_mb:
+            return
+        have = _available_mb()
+        if have is not None and need_mb > have:
+            raise SolverError(f"PARDISO out of core needs {need_mb} MB of memory for this matrix and {have} MB "
+                              "are free: the problem is too large for this machine")
+        log.info("PARDISO out of core: %d MB in memory (PARDISO's minimum for this matrix: %d KB)", need_mb, need_kb)
+        self.ooc_core_mb = need_mb
 
     @property
     def robust(self) -> bool:
@@ -443,6 +471,10 @@ def backward_error(norm: float, x: np.ndarray, r: np.ndarray, b: np.ndarray) -> 
 #: MKL's default is 2000).  Doubled while PARDISO reports too little (error -9; the 100k pinched
 #: cylinder needs 700-800).
 OOC_CORE_MB = 1000
+
+#: The factor's part held in memory out of core is at least this multiple of PARDISO's own minimum
+#: for the matrix (:meth:`KKTSystem._fit_ooc_core`).
+OOC_CORE_MARGIN = 1.1
 
 
 def _available_mb() -> int | None:
