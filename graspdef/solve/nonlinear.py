@@ -182,6 +182,11 @@ class PathOptions:
             raise ProblemError(f"anderson must be a non-negative integer, got {self.anderson!r}")
         if self.bifurcation not in BIFURCATION:
             raise ProblemError(f"bifurcation must be one of {', '.join(BIFURCATION)}, got {self.bifurcation!r}")
+        if self.bifurcation == "switch" and self.method == "arc_length":
+            # an arc-length path narrows every change of stability down itself (refine_critical)
+            # and stays on the branch it is on: the switch would be silently not made
+            raise ProblemError("bifurcation 'switch' is made by load-controlled paths (method 'load'), which "
+                               "then follow the new branch by arc length; an arc-length path stays on its branch")
         if self.predictor not in PREDICTORS:
             raise ProblemError(f"predictor must be one of {', '.join(PREDICTORS)}, got {self.predictor!r}")
         if not (0 <= self.inertia_rtol < 1e-2):

@@ -203,3 +203,11 @@ def test_arc_length_path_narrows_a_change_between_requested_levels(targets):
     assert np.all(np.diff(sol.load_factors()) > 0)
     for lam in targets:
         assert sol.at(lam).kind == "target"
+
+
+def test_switch_is_refused_for_arc_length_paths():
+    """An arc-length path narrows changes of stability down but stays on its branch: asking it to
+    switch is one clear error, not an option silently not acted on (before 2026-11-27 the path
+    ran to the end on the straight strip, tip deflection 0, ``branch_switched`` False)."""
+    with pytest.raises(ProblemError, match="bifurcation 'switch' is made by load-controlled paths"):
+        PathOptions(method="arc_length", bifurcation="switch")
