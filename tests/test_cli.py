@@ -267,3 +267,19 @@ def test_console_script_exits_with_the_commands_status(tmp_path, monkeypatch):
     with pytest.raises(SystemExit) as exc:
         console()
     assert exc.value.code == 2
+
+
+def test_a_path_records_its_cut_attempts_in_words(tmp_path):
+    """The run record lists every attempt the path cut (``convergence.events``), with its loads and
+    the reason in words: here the nonlinear plate in one step with at most 2 Newton iterations,
+    whose first attempt to the full load cannot converge and is halved (before 2026-11-27 the
+    events never left the solver)."""
+    f = tmp_path / "p.toml"
+    f.write_text(NONLINEAR.replace("steps = 4", "steps = 1\nmax_iterations = 2"))
+    main(["solve", str(f), "--out", str(tmp_path / "run")])
+    rec = json.loads((tmp_path / "run" / "result.json").read_text())
+    events = rec["convergence"]["events"]
+    assert events, rec["convergence"]
+    first = events[0]
+    assert first["from_load_factor"] == 0.0 and first["to_load_factor"] == 1.0
+    assert first["action"] == "load step halved" and "did not converge in 2 iterations" in first["reason"]

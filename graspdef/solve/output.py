@@ -80,7 +80,10 @@ def result_record(spec: ProblemSpec, sol: LinearSolution | NonlinearSolution) ->
                      "convergence": {"completed": sol.completed, "stop_reason": sol.stop_reason,
                                      "load_factor": sol.load_factor, "n_points": len(sol.path),
                                      "newton_iterations": sol.iterations(),
-                                     "n_factorisations": sol.n_factorisations},
+                                     "n_factorisations": sol.n_factorisations,
+                                     # every attempt that failed and was cut, and every critical
+                                     # point's bracket that could not be narrowed: why, in words
+                                     "events": [dict(e) for e in sol.events]},
                      "options": {k: (list(v) if isinstance(v, tuple) else v) for k, v in sol.options.__dict__.items()}})
         return RunRecord("solve", spec.name, "nonlinear", units, derived, {}, data)
     force, moment = sol.net_load()
