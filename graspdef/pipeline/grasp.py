@@ -368,10 +368,7 @@ def grasp_record(obj: GraspObject, st: Settled, setup: ShellSetup, solved: Solve
                                        "elastic energy of the shell at the final state, from its stress-free shape")
     conv = {"completed": solved.completed, "stop_reason": solved.stop_reason}
     if hasattr(sol, "path"):
-        conv.update({"load_factor": sol.load_factor, "n_points": len(sol.path),
-                     "newton_iterations": sol.iterations(), "n_factorisations": sol.n_factorisations,
-                     "critical_points": [dict(cp, probes={k: np.asarray(v).tolist() for k, v in cp["probes"].items()})
-                                         for cp in sol.critical_points]})
+        conv.update(sol.convergence())
     else:
         conv.update({"relative_residual": sol.kkt.residual})
     if analysis == "linear" and fingertips:

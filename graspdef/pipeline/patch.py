@@ -307,11 +307,7 @@ def patch_record(obj, st, pps: list, solved: list, force: float, analysis: str, 
             conv["patches"][s] = {"relative_residual": sol.kkt.residual}
         else:
             strain += float(ShellEnergy(pp.problem.shell).energy(pp.problem.shell.rest_positions + u))
-            conv["patches"][s] = {"load_factor": sol.load_factor, "n_points": len(sol.path),
-                                  "newton_iterations": sol.iterations(), "n_factorisations": sol.n_factorisations,
-                                  "critical_points": [dict(cp, probes={k: np.asarray(v).tolist()
-                                                                       for k, v in cp["probes"].items()})
-                                                      for cp in sol.critical_points]}
+            conv["patches"][s] = sol.convergence()
     rest, deformed, disp, faces = (np.concatenate(a) for a in (rest, deformed, disp, faces))
     reference = "rest shape (the patch model has no air)"
     derived = {"max_displacement": D.max_displacement(rest, disp, "m", rigid_motion_removed=False, reference=reference)}

@@ -72,18 +72,12 @@ def result_record(spec: ProblemSpec, sol: LinearSolution | NonlinearSolution) ->
                   "probes": _probes(sol), **_mesh_counts(sol),
                   "timings_s": {k: float(v) for k, v in sol.timings.items()}}
     if isinstance(sol, NonlinearSolution):
-        crit = [dict(cp, probes={k: np.asarray(v).tolist() for k, v in cp["probes"].items()})
-                for cp in sol.critical_points]
+        conv = sol.convergence()
+        crit = conv.pop("critical_points")
         derived["total_potential_energy"] = D.entry(sol.path[-1].energy, E, "total potential energy",
                                                     "shell energy minus the work of the loads at the last point")
         data.update({"method": sol.options.method, "stable": sol.path[-1].stable, "critical_points": crit,
-                     "convergence": {"completed": sol.completed, "stop_reason": sol.stop_reason,
-                                     "load_factor": sol.load_factor, "n_points": len(sol.path),
-                                     "newton_iterations": sol.iterations(),
-                                     "n_factorisations": sol.n_factorisations,
-                                     # every attempt that failed and was cut, and every critical
-                                     # point's bracket that could not be narrowed: why, in words
-                                     "events": [dict(e) for e in sol.events]},
+                     "convergence": {"completed": sol.completed, "stop_reason": sol.stop_reason, **conv},
                      "options": {k: (list(v) if isinstance(v, tuple) else v) for k, v in sol.options.__dict__.items()}})
         return RunRecord("solve", spec.name, "nonlinear", units, derived, {}, data)
     force, moment = sol.net_load()
