@@ -283,3 +283,71 @@ def test_a_path_records_its_cut_attempts_in_words(tmp_path):
     first = events[0]
     assert first["from_load_factor"] == 0.0 and first["to_load_factor"] == 1.0
     assert first["action"] == "load step halved" and "did not converge in 2 iterations" in first["reason"]
+
+
+EULER_STRIP = """name = "euler_strip"
+[units]
+length = "consistent"
+force = "consistent"
+[geometry]
+type = "rectangle"
+lx = 10.0
+ly = 1.0
+nx = 20
+ny = 2
+center = [5.0, 0.5]
+[material]
+model = "saint_venant_kirchhoff"
+E = 1.2e6
+nu = 0.0
+[shell]
+thickness = 0.1
+[regions]
+root = "abs(x) < 1e-9"
+tip = "abs(x - 10) < 1e-9"
+[[supports]]
+kind = "clamped"
+region = "root"
+[[loads]]
+kind = "edge_load"
+region = "tip"
+force = [-2.4674011002723395, 0.0, 0.0]   # Euler's load pi^2 EI / (4 L^2) per unit width
+[solver]
+type = "nonlinear"
+steps = 10
+max_load = 1.2
+bifurcation = "locate"
+"""
+
+
+def test_solve_says_when_a_critical_point_could_not_be_narrowed(tmp_path, capsys, monkeypatch):
+    """Euler's strip through ``graspdef solve`` with Newton made to fail at every point that
+    would narrow the bifurcation down: the progress says so in one line, with the reason, and
+    result.json's events hold it (the strip's own narrowing is tests/solve/test_bifurcation.py)."""
+    import graspdef.solve.nonlinear as nl
+
+    newton, locate = nl.PathSolver.newton, nl.PathSolver._locate
+
+    def locating(self, *args, **kwargs):
+        self.locating = True
+        try:
+            return locate(self, *args, **kwargs)
+        finally:
+            self.locating = False
+
+    def failing(self, u0, lam, *args, **kwargs):
+        if getattr(self, "locating", False):
+            raise nl._Failed(f"injected failure at load factor {lam:.6g}")
+        return newton(self, u0, lam, *args, **kwargs)
+
+    monkeypatch.setattr(nl.PathSolver, "_locate", locating)
+    monkeypatch.setattr(nl.PathSolver, "newton", failing)
+    f = tmp_path / "strip.toml"
+    f.write_text(EULER_STRIP)
+    assert main(["solve", str(f), "--out", str(tmp_path / "run")]) == 0
+    err = capsys.readouterr().err
+    assert "bifurcation point at load factor" in err
+    line = next(ln for ln in err.splitlines() if "was not narrowed further" in ln)
+    assert "injected failure" in line
+    rec = json.loads((tmp_path / "run" / "result.json").read_text())
+    assert [e["action"] for e in rec["convergence"]["events"]] == [nl.BRACKET_NOT_NARROWED]

@@ -43,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
     unit = spec.length_unit
     stopped = None
     if spec.solver.get("type", "linear") == "nonlinear":
-        from ..solve.nonlinear import PathStopped, path_options, solve_nonlinear
+        from ..solve.nonlinear import BRACKET_NOT_NARROWED, PathStopped, path_options, solve_nonlinear
 
         try:
             sol = solve_nonlinear(spec.problem, path_options(spec.solver), backend=backend,
@@ -61,6 +61,10 @@ def run(args: argparse.Namespace) -> int:
                            + ("" if jump is None else f"; the path jumped to the equilibrium at load factor "
                               f"{jump['to_load_factor']:.6g}, the largest control point moving "
                               f"{jump['largest_control_point_move'] / spec.length_scale:.4g} {unit}"))
+        for ev in sol.events:
+            if ev.get("action") == BRACKET_NOT_NARROWED:
+                progress(args, f"a critical point's bracket from load factor {ev['from_load_factor']:.6g} was not "
+                               f"narrowed further: {ev['reason']}")
     else:
         from ..solve.linear import solve_linear
 

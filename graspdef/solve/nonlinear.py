@@ -67,6 +67,9 @@ FOLD_SHORT = 0.9
 #: the bracket from its stable end, in this order (:meth:`PathSolver._locate`)
 LOCATE_SPLITS = (0.5, 0.25, 0.75)
 
+#: the ``action`` of the event a critical point's bracket that could not be narrowed leaves
+BRACKET_NOT_NARROWED = "critical point's bracket not narrowed further"
+
 
 def fold_estimate(lam1: float, n1: float, lam2: float, n2: float) -> float | None:
     """The load factor of a limit point ahead, from the tangent norms n = |du/dlam| at two
@@ -987,7 +990,7 @@ class PathSolver:
                     why = str(exc)
             else:
                 sol.events.append({"from_load_factor": float(lam_a), "to_load_factor": float(lam_b),
-                                   "action": "critical point's bracket not narrowed further",
+                                   "action": BRACKET_NOT_NARROWED,
                                    "reason": f"no equilibrium found inside it ({why})"})
                 break
             pt = self._record(u_m, lam_m, st, its, inst, "refine")
@@ -1102,7 +1105,7 @@ class PathSolver:
                     why = str(exc)
             else:
                 sol.events.append({"from_load_factor": float(lam), "arc_length": float(w),
-                                   "action": "critical point's bracket not narrowed further",
+                                   "action": BRACKET_NOT_NARROWED,
                                    "reason": f"no equilibrium found inside it ({why})"})
                 break
             pt = self._record(uh, lh, sth, ih, insth, "refine")
