@@ -315,6 +315,20 @@ class _Failed(Exception):
     diagnosed = False             # the softest-mode diagnosis ran already (its finding, if any, is in the message)
 
 
+def _first_split(attempt: Callable[[float], tuple]):
+    """(f, attempt(f)) for the first fraction f of a critical point's bracket in ``LOCATE_SPLITS``
+    at which ``attempt`` converges -- the midpoint; where Newton fails there (the tangent is nearly
+    singular at a critical load: a perfect sphere under pressure loses stability in 2l+1 modes at
+    once), a quarter of the way in from either end -- or (None, why the last one failed)."""
+    why = ""
+    for f in LOCATE_SPLITS:
+        try:
+            return f, attempt(f)
+        except (_Failed, SolverError) as exc:
+            why = str(exc)
+    return None, why
+
+
 class PathSolver:
     """Runs one path (see the module docstring); use :func:`solve_nonlinear`."""
 
@@ -978,21 +992,13 @@ class PathSolver:
         a_side, b_side = [], []
         crit = (u_b, lam_b)
         for _ in range(self.opt.refine_critical):
-            # the midpoint; where Newton fails there (the tangent is nearly singular at a
-            # critical load: a perfect sphere under pressure loses stability in 2l+1 modes at
-            # once), a quarter of the way in from either end
-            for frac in LOCATE_SPLITS:
-                lam_m = (1 - frac) * lam_a + frac * lam_b
-                try:
-                    u_m, st, its, inst = self.newton((1 - frac) * u_a + frac * u_b, lam_m)
-                    break
-                except (_Failed, SolverError) as exc:
-                    why = str(exc)
-            else:
+            frac, got = _first_split(lambda f: self.newton((1 - f) * u_a + f * u_b, (1 - f) * lam_a + f * lam_b))
+            if frac is None:
                 sol.events.append({"from_load_factor": float(lam_a), "to_load_factor": float(lam_b),
-                                   "action": BRACKET_NOT_NARROWED,
-                                   "reason": f"no equilibrium found inside it ({why})"})
+                                   "action": BRACKET_NOT_NARROWED, "reason": f"no equilibrium found inside it ({got})"})
                 break
+            lam_m = (1 - frac) * lam_a + frac * lam_b
+            u_m, st, its, inst = got
             pt = self._record(u_m, lam_m, st, its, inst, "refine")
             if inst == inst_a:
                 a_side.append(pt)
@@ -1097,17 +1103,12 @@ class PathSolver:
         a_side, b_side = [], []
         w = dl                                       # the bracket's arc length from (u, lam)
         for _ in range(self.opt.refine_critical):
-            for frac in LOCATE_SPLITS:
-                try:
-                    uh, lh, ih, sth, insth = self._arc_step(u, lam, frac * w, du_prev, dlam_prev)
-                    break
-                except (_Failed, SolverError) as exc:
-                    why = str(exc)
-            else:
+            frac, got = _first_split(lambda f: self._arc_step(u, lam, f * w, du_prev, dlam_prev))
+            if frac is None:
                 sol.events.append({"from_load_factor": float(lam), "arc_length": float(w),
-                                   "action": BRACKET_NOT_NARROWED,
-                                   "reason": f"no equilibrium found inside it ({why})"})
+                                   "action": BRACKET_NOT_NARROWED, "reason": f"no equilibrium found inside it ({got})"})
                 break
+            uh, lh, ih, sth, insth = got
             pt = self._record(uh, lh, sth, ih, insth, "refine")
             if insth == inst_a:
                 a_side.append(pt)
