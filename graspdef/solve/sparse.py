@@ -251,6 +251,13 @@ class KKTSystem:
         new_pattern = self._map is None or not self._map.matches(K)
         upper_map = _UpperMap(K, self.C) if new_pattern else self._map
         U = upper_map.upper(K, self.scale)
+        if self.backend == "pardiso-ooc" and self._solver is not None and (analyse or new_pattern):
+            # out of core, a second analysis on the same PARDISO handle crashes the process in the
+            # factorisation after it (a nonlinear path's tangent fills structural zeros of the rest
+            # stiffness: 30,755 -> 55,359 non-zeros on the cantilever, then a segmentation fault in
+            # graspdef solve --backend pardiso-ooc until 2026-11-27): a fresh handle and folder for
+            # every analysis
+            self.close()
         if self._solver is None:
             self._solver = _new_pardiso(-2)
             ooc = {60: 2} if self.backend == "pardiso-ooc" else {}

@@ -154,6 +154,30 @@ def test_graspdef_solve_out_of_core(tmp_path):
     assert w["pardiso-ooc"] == pytest.approx(w["pardiso"], rel=1e-10, abs=0)
 
 
+@needs_pardiso
+def test_graspdef_solve_out_of_core_follows_a_nonlinear_path(tmp_path):
+    """A nonlinear path out of core: its tangents fill structural zeros of the flat plate's rest
+    stiffness (the cantilever rolled up by an end moment, to 0.1 of it in two steps: 30,755 -> 55,359
+    non-zeros), so PARDISO analyses a second pattern -- on the same handle, out of core, that crashed
+    the process in the next factorisation (segmentation fault, exit -11, until 2026-11-27; a path
+    whose tangents keep the rest stiffness's pattern, e.g. the 8 x 8 plate, did not crash).  Now each analysis gets a
+    fresh handle: the run completes with the in-core path's tip displacement (to 1e-9 of it)."""
+    text = (ROOT / "benchmarks" / "nonlinear" / "cantilever_moment.toml").read_text()
+    path = tmp_path / "cantilever.toml"
+    path.write_text(text.replace("steps = 20", "steps = 2\nmax_load = 0.1"))
+    w = {}
+    for backend in ("pardiso", "pardiso-ooc"):
+        r = subprocess.run([sys.executable, "-c", "from graspdef.cli import console; console()",   # the console script
+                            "-q", "solve", str(path), "--backend", backend,
+                            "--out", str(tmp_path / backend)], capture_output=True, text=True, cwd=tmp_path,
+                           env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=300, check=False)
+        assert r.returncode == 0, (r.returncode, r.stderr[-3000:])
+        rec = json.loads((tmp_path / backend / "result.json").read_text())
+        assert rec["convergence"]["completed"]
+        w[backend] = rec["probes"]["tip"]["displacement"][0]
+    assert w["pardiso-ooc"] == pytest.approx(w["pardiso"], rel=1e-9, abs=0)
+
+
 def test_the_backend_is_a_problem_file_setting(tmp_path):
     """[solver] backend = "pardiso-ooc" is accepted; a misspelt one is refused by name."""
     from graspdef.problem.config import load_problem
