@@ -133,6 +133,17 @@ out["folder_gone"] = not os.path.exists(folder)
     assert out["folder_gone"]
 
 
+def _solve_cli(tmp_path, path, backend: str) -> dict:
+    """``graspdef solve PATH --backend BACKEND`` in a process of its own (the console script); its
+    result.json, after requiring exit status 0."""
+    r = subprocess.run([sys.executable, "-c", "from graspdef.cli import console; console()",
+                        "-q", "solve", str(path), "--backend", backend,
+                        "--out", str(tmp_path / backend)], capture_output=True, text=True, cwd=tmp_path,
+                       env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=300, check=False)
+    assert r.returncode == 0, (r.returncode, r.stderr[-3000:])
+    return json.loads((tmp_path / backend / "result.json").read_text())
+
+
 @needs_pardiso
 def test_graspdef_solve_out_of_core(tmp_path):
     """``graspdef solve --backend pardiso-ooc`` (a process of its own): the run folder records the
@@ -143,12 +154,7 @@ def test_graspdef_solve_out_of_core(tmp_path):
     path.write_text(plate_problem(n=12))
     w = {}
     for backend in ("pardiso", "pardiso-ooc"):
-        r = subprocess.run([sys.executable, "-c", "from graspdef.cli import console; console()",   # the console script
-                            "-q", "solve", str(path), "--backend", backend,
-                            "--out", str(tmp_path / backend)], capture_output=True, text=True, cwd=tmp_path,
-                           env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=300, check=False)
-        assert r.returncode == 0, r.stderr[-3000:]
-        rec = json.loads((tmp_path / backend / "result.json").read_text())
+        rec = _solve_cli(tmp_path, path, backend)
         assert rec["solver"]["backend"] == backend
         w[backend] = rec["probes"]["centre"]["displacement"][2]
     assert w["pardiso-ooc"] == pytest.approx(w["pardiso"], rel=1e-10, abs=0)
@@ -160,19 +166,15 @@ def test_graspdef_solve_out_of_core_follows_a_nonlinear_path(tmp_path):
     stiffness (the cantilever rolled up by an end moment, to 0.1 of it in two steps: 30,755 -> 55,359
     non-zeros), so PARDISO analyses a second pattern -- on the same handle, out of core, that crashed
     the process in the next factorisation (segmentation fault, exit -11, until 2026-11-27; a path
-    whose tangents keep the rest stiffness's pattern, e.g. the 8 x 8 plate, did not crash).  Now each analysis gets a
-    fresh handle: the run completes with the in-core path's tip displacement (to 1e-9 of it)."""
+    whose tangents keep the rest stiffness's pattern, e.g. the 8 x 8 plate, did not crash).  Now
+    each analysis gets a fresh handle: the run completes with the in-core path's tip displacement
+    (to 1e-9 of it)."""
     text = (ROOT / "benchmarks" / "nonlinear" / "cantilever_moment.toml").read_text()
     path = tmp_path / "cantilever.toml"
     path.write_text(text.replace("steps = 20", "steps = 2\nmax_load = 0.1"))
     w = {}
     for backend in ("pardiso", "pardiso-ooc"):
-        r = subprocess.run([sys.executable, "-c", "from graspdef.cli import console; console()",   # the console script
-                            "-q", "solve", str(path), "--backend", backend,
-                            "--out", str(tmp_path / backend)], capture_output=True, text=True, cwd=tmp_path,
-                           env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=300, check=False)
-        assert r.returncode == 0, (r.returncode, r.stderr[-3000:])
-        rec = json.loads((tmp_path / backend / "result.json").read_text())
+        rec = _solve_cli(tmp_path, path, backend)
         assert rec["convergence"]["completed"]
         w[backend] = rec["probes"]["tip"]["displacement"][0]
     assert w["pardiso-ooc"] == pytest.approx(w["pardiso"], rel=1e-9, abs=0)
