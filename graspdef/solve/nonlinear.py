@@ -953,8 +953,7 @@ class PathSolver:
                 self._check_spurious(last, inst_t, lam_a, u_t, s)
                 if opt.refine_critical and last is not None and inst_t is not None and inst_t != last \
                         and mode is None:
-                    sol.path += self._bracket(sol, u_a, lam_a, float(np.linalg.norm(u_t - u_a)), u_t - u_a,
-                                              s - lam_a, last)
+                    sol.path += self._bracket_between(sol, u_a, lam_a, u_t, s, last)
                 sol.path.append(pt)
                 self._emit(sol, pt, dl)
                 if abs(s - lam_end) <= 1e-12 * abs(lam_end):
@@ -965,12 +964,8 @@ class PathSolver:
             last = sol.path[-1].instability
             self._check_spurious(last, inst, lam if prev is None else prev[1], u_new, lam_new)
             if opt.refine_critical and last is not None and inst is not None and inst != last and mode is None:
-                if prev is None:
-                    sol.path += self._bracket(sol, u, lam, dl, du_prev, dlam_prev, last)
-                else:
-                    u_a, lam_a = prev
-                    sol.path += self._bracket(sol, u_a, lam_a, float(np.linalg.norm(u_new - u_a)), u_new - u_a,
-                                              lam_new - lam_a, last)
+                sol.path += (self._bracket(sol, u, lam, dl, du_prev, dlam_prev, last) if prev is None
+                             else self._bracket_between(sol, *prev, u_new, lam_new, last))
             pt = self._record(u_new, lam_new, st, its, inst, "step" if mode is None else "branch")
             mode = None
             sol.path.append(pt)
@@ -1119,6 +1114,11 @@ class PathSolver:
                 b_side.append(pt)
                 w *= frac
         return a_side + b_side[::-1]
+
+    def _bracket_between(self, sol, u_a, lam_a, u_b, lam_b, inst_a):
+        """:meth:`_bracket` from the converged (u_a, lam_a) towards the converged (u_b, lam_b) of
+        another stability: the arc length between them, their difference as the direction."""
+        return self._bracket(sol, u_a, lam_a, float(np.linalg.norm(u_b - u_a)), u_b - u_a, lam_b - lam_a, inst_a)
 
     def _arc_step(self, u, lam, dl, du_prev, dlam_prev):
         """One Crisfield step of arc length dl; returns (u, lam, iterations, state, instability)."""
