@@ -191,8 +191,8 @@ def _balloon_records(spec, sol, ref, tol, n_control, seconds):
 
 def benchmark_path_options(spec, context: dict | None = None):
     """The path options a benchmark file is solved with: its [solver] options, plus its tabulated
-    load factors (and its context's) as path targets, or -- for a curve compared along a
-    displacement-controlled path -- a step of at most max_load / steps (the levels are abscissa
+    load factors (and its context's) as path targets, or -- for a curve compared along a load- or
+    displacement-controlled path (method "load") -- a step of at most max_load / steps (the levels are abscissa
     values, e.g. P/P_max, interpolated between path points, not load factors)."""
     from dataclasses import replace
 
@@ -204,7 +204,7 @@ def benchmark_path_options(spec, context: dict | None = None):
         extra = {float(v) for v in ref.get("load_factors", [])} | set(context["load_factors"] if context else ())
         if extra:
             opts = replace(opts, targets=tuple(sorted(set(opts.targets) | extra - {opts.max_load})))
-    elif opts.max_step is None:
+    elif opts.method == "load" and opts.max_step is None:
         # grown steps left the pull-out's points 0.05 apart at its snap and the linear
         # interpolation there 5.7 % off
         opts = replace(opts, max_step=abs(opts.max_load) / opts.steps)

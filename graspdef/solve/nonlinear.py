@@ -48,6 +48,16 @@ METHODS = ("load", "arc_length")
 BIFURCATION = ("report", "locate", "switch")
 LIMIT_POINTS = ("jump", "stop")
 PREDICTORS = ("quadratic", "linear")
+#: options read by load-controlled paths only (PathSolver._load_control); an arc-length path
+#: refuses them rather than ignore them
+LOAD_CONTROL_ONLY = ("max_step", "jump_ratio", "predictor", "limit_points")
+
+
+def _refuse_load_control_options(names) -> None:
+    if names:
+        raise ProblemError(f"{', '.join(names)} {'is an option' if len(names) == 1 else 'are options'} of "
+                           "load-controlled paths (method 'load'); an arc-length path sets its steps by arc "
+                           "length (steps, max_growth, desired_iterations) and follows limit points itself")
 #: Loosest forcing term of an inexact Newton step (|F + J s| <= eta |F|; Eisenstat & Walker 1996)
 KRYLOV_ETA_MAX = 0.1
 
@@ -141,6 +151,10 @@ class PathOptions:
         the one that Newton finds from the last point at the load of one initial step further),
         record it in ``critical_points`` (kind "limit point (jumped)", with the bracket and the
         jump) and go on; "stop": end the path there (graspdef's finger-contact paths stop)
+
+    max_step, jump_ratio, predictor and limit_points are read by load-controlled paths only: with
+    ``method = "arc_length"`` a value other than the default is refused (ProblemError), and so is
+    any of them in a problem file's [solver] table (:func:`path_options`).
     """
 
     method: str = "load"
@@ -190,6 +204,10 @@ class PathOptions:
             # and stays on the branch it is on: the switch would be silently not made
             raise ProblemError("bifurcation 'switch' is made by load-controlled paths (method 'load'), which "
                                "then follow the new branch by arc length; an arc-length path stays on its branch")
+        if self.method == "arc_length":
+            # set to other than their defaults (path_options also refuses them when given at all)
+            _refuse_load_control_options([k for k in LOAD_CONTROL_ONLY
+                                          if getattr(self, k) != PathOptions.__dataclass_fields__[k].default])
         if self.predictor not in PREDICTORS:
             raise ProblemError(f"predictor must be one of {', '.join(PREDICTORS)}, got {self.predictor!r}")
         if not (0 <= self.inertia_rtol < 1e-2):
@@ -219,8 +237,11 @@ class PathOptions:
 
 def path_options(table: dict) -> PathOptions:
     """PathOptions from a problem file's [solver] table (values already in SI; the keys that are
-    not path options -- type, backend, collocation -- are ignored)."""
+    not path options -- type, backend, collocation -- are ignored).  A load-control option in
+    an arc-length path's table is refused, even at its default value."""
     keys = set(PathOptions.__dataclass_fields__)
+    if table.get("method") == "arc_length":
+        _refuse_load_control_options([k for k in LOAD_CONTROL_ONLY if k in table])
     return PathOptions(**{k: v for k, v in table.items() if k in keys})
 
 

@@ -211,3 +211,39 @@ def test_switch_is_refused_for_arc_length_paths():
     ran to the end on the straight strip, tip deflection 0, ``branch_switched`` False)."""
     with pytest.raises(ProblemError, match="bifurcation 'switch' is made by load-controlled paths"):
         PathOptions(method="arc_length", bifurcation="switch")
+
+
+@pytest.mark.parametrize("option,value", [("max_step", 0.05), ("jump_ratio", 0.1), ("predictor", "linear"),
+                                          ("limit_points", "stop")])
+def test_load_control_options_are_refused_for_arc_length_paths(option, value):
+    """The options that only a load-controlled path reads are one clear error on an arc-length
+    path, not silently ignored (before 2026-11-27 every one of them was accepted and had no effect):
+    set to other than the default in Python, and given at all in a problem file's [solver] table
+    (even at the default value); the same values on a load-controlled path are accepted."""
+    from graspdef.solve.nonlinear import path_options
+
+    with pytest.raises(ProblemError, match=f"^{option} is an option of load-controlled paths"):
+        PathOptions(method="arc_length", **{option: value})
+    default = PathOptions.__dataclass_fields__[option].default
+    assert PathOptions(method="arc_length", **{option: default}).method == "arc_length"
+    with pytest.raises(ProblemError, match=f"^{option} is an option of load-controlled paths"):
+        path_options({"type": "nonlinear", "method": "arc_length", option: default})
+    assert getattr(path_options({"method": "load", option: value}), option) == value
+
+
+def test_graspdef_solve_names_every_refused_option(tmp_path, capsys):
+    """graspdef solve on an arc-length problem file with two load-control options: exit 2, no run
+    folder, and one line naming both."""
+    from graspdef.cli import main
+    from graspdef.testing import plate_problem
+
+    path = tmp_path / "plate.toml"
+    text = plate_problem(n=4)
+    assert "[solver]" not in text
+    path.write_text(text + '\n[solver]\ntype = "nonlinear"\nmethod = "arc_length"\nmax_step = 0.1\n'
+                    'predictor = "linear"\n')
+    r = main(["-q", "solve", str(path), "--out", str(tmp_path / "out")])
+    assert r == 2
+    assert not (tmp_path / "out" / "result.json").exists()
+    err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert len(err) == 1 and "max_step, predictor are options of load-controlled paths" in err[0], err
