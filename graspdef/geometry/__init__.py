@@ -24,6 +24,7 @@ from graspdef.geometry.primitives import (
     polygon,
     rectangle,
     sphere,
+    spherical_cap,
     square_plate,
 )
 from graspdef.geometry.regions import compile_predicate
@@ -32,5 +33,5 @@ __all__ = [
     "LENGTH_UNITS", "TriMesh", "annulus", "boundary_edges", "boundary_loops", "compile_predicate",
     "cylinder", "edge_face_counts", "ellipsoid", "height_field", "hemisphere", "icosphere",
     "disk", "is_closed", "length_scale", "load_mesh", "monkey_saddle", "polygon", "rectangle", "save_ply", "sphere",
-    "square_plate", "unique_edges", "validate_mesh", "vertex_valence",
+    "spherical_cap", "square_plate", "unique_edges", "validate_mesh", "vertex_valence",
 ]

@@ -661,3 +661,35 @@ def disk(radius: float, edge_length: float = 1.0, refinements: int = 2,
     v = m.vertices.copy()
     v[:, :2] += c
     return TriMesh(v, m.faces).validated("disk")
+
+
+def spherical_cap(radius: float, rise: float, edge_length: float = 1.0, refinements: int = 2) -> TriMesh:
+    """Spherical cap of sphere radius ``radius`` and height ``rise`` over its base circle, apex up
+    at (0, 0, rise), base circle in z = 0 (of radius sqrt(rise (2 radius - rise))), outward (+z
+    side) normals.
+
+    The mesh is :func:`disk`'s of radius R phi0 (the cap's meridian length; phi0 = acos(1 -
+    rise / radius) is its half-angle) wrapped onto the sphere along geodesic polar coordinates: a
+    disk point at distance s from the centre goes to the polar angle s / R.  Its boundary vertices
+    are on the base circle exactly, and the edge lengths are those of the disk up to the factor
+    sin(s/R) / (s/R) around the apex (at least 0.96 up to a 30 degree cap).
+
+    Parameters
+    ----------
+    radius : float   sphere radius R [m]
+    rise : float     height H of the apex over the base plane [m], 0 < H <= R (up to a hemisphere)
+    edge_length : float   target edge length [m] of the final mesh (see :func:`disk`)
+    refinements : int   midpoint refinements of the coarse mesh (see :func:`disk`)
+    """
+    R = _positive(radius, "radius")
+    H = _positive(rise, "rise")
+    if H > R * (1 + 1e-12):
+        raise ProblemError(f"rise must not exceed the radius (a cap up to a hemisphere), got rise {H!r} > radius {R!r}")
+    phi0 = math.acos(max(1.0 - H / R, 0.0))
+    m = disk(R * phi0, edge_length, refinements)
+    x, y = m.vertices[:, 0], m.vertices[:, 1]
+    phi, th = np.hypot(x, y) / R, np.arctan2(y, x)
+    v = np.stack([R * np.sin(phi) * np.cos(th), R * np.sin(phi) * np.sin(th), R * np.cos(phi) - (R - H)], axis=1)
+    b = _boundary_vertices(m.faces)
+    v[b, 2] = 0.0                    # on the base plane to the last bit (cos(phi0) R - (R - H) rounds)
+    return TriMesh(v, m.faces).validated("spherical_cap")

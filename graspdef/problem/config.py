@@ -46,6 +46,7 @@ _GEOMETRY = {
     "annulus": {"r_inner", "r_outer", "n_theta", "n_r", "slit_deg"},
     "polygon": {"outer", "holes", "edge_length", "refinements"},
     "disk": {"radius", "edge_length", "refinements", "center"},
+    "spherical_cap": {"radius", "rise", "edge_length", "refinements"},
     "mesh": {"path", "units"},
 }
 _GEOMETRY_OPTIONAL = {"center", "theta0_deg", "theta1_deg", "hole_angle_deg", "scale", "units", "slit_deg", "holes", "refinements"}
@@ -60,7 +61,7 @@ _SOLVER = {"backend": "str", "collocation": "int", "nitsche_gamma": "float", "ty
            "krylov": "int", "krylov_rtol": "float", "jump_ratio": "float", "limit_points": "str",
            "bifurcation": "str", "predictor": "str"}
 _LENGTH_KEYS = {"lx", "ly", "center", "a", "b", "c", "radius", "length", "half_width", "scale", "r_inner", "r_outer",
-                "edge_length"}
+                "edge_length", "rise"}
 _REFERENCE = {"value", "quantity", "tolerance", "source", "formula", "load_factors", "values", "curve",
               "curve_params", "compare", "abscissa", "abscissa_scale", "range_normalised",
               "reaction_scale", "limit_point", "context"}
