@@ -686,7 +686,13 @@ def spherical_cap(radius: float, rise: float, edge_length: float = 1.0, refineme
     if H > R * (1 + 1e-12):
         raise ProblemError(f"rise must not exceed the radius (a cap up to a hemisphere), got rise {H!r} > radius {R!r}")
     phi0 = math.acos(max(1.0 - H / R, 0.0))
-    m = disk(R * phi0, edge_length, refinements)
+    h = _positive(edge_length, "edge_length")
+    coarse = h * 2 ** _count(refinements, "refinements", 0)
+    if coarse >= 2 * R * phi0:
+        raise ProblemError(f"edge_length x 2**refinements = {coarse:g} is not below the cap's width along the "
+                           f"sphere, 2 R phi0 = {2 * R * phi0:g}: too few cells (shorten edge_length or use "
+                           "fewer refinements)")
+    m = disk(R * phi0, h, refinements)
     x, y = m.vertices[:, 0], m.vertices[:, 1]
     phi, th = np.hypot(x, y) / R, np.arctan2(y, x)
     v = np.stack([R * np.sin(phi) * np.cos(th), R * np.sin(phi) * np.sin(th), R * np.cos(phi) - (R - H)], axis=1)

@@ -100,3 +100,10 @@ def test_the_axisymmetric_reference_is_reproduced(study):
     a = study.axisym_cap("3d")
     assert abs(a["limit_load"] / REF["limit_point"]["value"] - 1) <= 1e-5, a["limit_load"]
     assert abs(a["deflection_at_limit"] / REF["limit_point"]["at"] - 1) <= 1e-3, a["deflection_at_limit"]
+
+
+def test_spherical_cap_with_too_few_cells_says_so():
+    """An edge length (times 2**refinements) not below the cap's width along the sphere is one line
+    about the cap, not about the disk's polygon it is made from."""
+    with pytest.raises(ProblemError, match=r"not below the cap's width along the sphere, 2 R phi0 = 46\.2"):
+        spherical_cap(100.0, 8.0 / 3.0, 1000.0, 4)
