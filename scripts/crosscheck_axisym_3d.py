@@ -409,6 +409,8 @@ def plot(res, path):
 
 
 def main() -> None:
+    from _study import write_results      # scripts/_study.py (run as a script: scripts/ is on the path)
+
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default="out/crosscheck")
     ap.add_argument("--fast", action="store_true",
@@ -430,10 +432,7 @@ def main() -> None:
     res = run(subs, ratios, infl, a.n_ring, a.fast, a.jobs)
     res["total_seconds"] = time.perf_counter() - t0
     out = Path(a.out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "crosscheck.json").write_text(json.dumps(res, indent=2) + "\n")
-    plot(res, out / "crosscheck.png")
-    print(f"\nwrote {out / 'crosscheck.json'} and {out / 'crosscheck.png'} ({res['total_seconds']:.0f} s)")
+    write_results(out, "crosscheck", res, plot)
 
 
 if __name__ == "__main__":

@@ -172,6 +172,8 @@ def plot(res, path):
 
 
 def main() -> None:
+    from _study import write_results      # scripts/_study.py (run as a script: scripts/ is on the path)
+
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default="out/shallow_cap")
     ap.add_argument("--fast", action="store_true", help="two 3-D meshes, no fine axisymmetric run (~1 min)")
@@ -184,10 +186,7 @@ def main() -> None:
     t0 = time.perf_counter()
     res = run(a.fast)
     res["total_seconds"] = time.perf_counter() - t0
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "shallow_cap.json").write_text(json.dumps(res, indent=2) + "\n")
-    plot(res, out / "shallow_cap.png")
-    print(f"\nwrote {out / 'shallow_cap.json'} and {out / 'shallow_cap.png'} ({res['total_seconds']:.0f} s)")
+    write_results(out, "shallow_cap", res, plot)
 
 
 if __name__ == "__main__":
