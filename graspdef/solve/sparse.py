@@ -203,10 +203,20 @@ class KKTSystem:
         the C interface).  MKL sizes its out-of-core buffers by the OpenMP thread count and requires
         it unchanged from the analysis to the factorisation and solution phases (Intel, "How to use
         Intel MKL OOC PARDISO"), while numba's OpenMP kernels run between those phases in the same
-        runtime (GNU OpenMP).  Without the held count, 4 of 80 runs of
-        tests/solve/test_kkt_out_of_core.py failed -- a solution off by 5e-5 at a residual of 2e-12,
-        a Python ``AttributeError`` inside pypardiso (overwritten memory), an abort at exit -- and 1
-        of 60 processes with two out-of-core solvers aborted at exit; with it, 0 of 80 and 0 of 90."""
+        runtime (GNU OpenMP).
+
+        The folder is given **without a trailing separator**: MKL 2026.2 appends "/mkl_pardiso" to
+        the path itself, and for a path that ends in "/" its configuration reader
+        (``mkl_pds_lp64_pardiso_ooc_read_cfg_file``, in ``mkl_serv_sprintf_s``) writes one byte past
+        a heap buffer -- found with valgrind's memcheck (an "Invalid write of size 1", 7 bytes after
+        a 56-byte Python object) on a 900-unknown system; with the path "/tmp/x/" the same, with
+        "/tmp/x" or any path without the final "/" none.  The overwritten byte lands wherever the heap
+        puts the buffer's neighbour, and it explains every intermittent out-of-core failure seen
+        here (README "Out of core"): solutions off by 5e-5 to 2.1 in relative residual, Python
+        objects swapped (``float()`` of a PathSolver, an ``AttributeError`` inside pypardiso), aborts
+        at exit -- about 1 in 50-100 runs of tests/solve/test_kkt_out_of_core.py until 2026-11-27,
+        with or without the held thread count (which the held count had seemed to cure: 4 of 80 ->
+        0 of 80)."""
         if self._ooc_dir is None:
             yield
             return
@@ -215,7 +225,7 @@ class KKTSystem:
             self._ooc_threads = int(lib.MKL_Get_Max_Threads())
         prev = lib.MKL_Set_Num_Threads_Local(ctypes.c_int(self._ooc_threads))
         try:
-            with environment({"MKL_PARDISO_OOC_PATH": self._ooc_dir + os.sep,
+            with environment({"MKL_PARDISO_OOC_PATH": ooc_path(self._ooc_dir),
                               "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(self.ooc_core_mb),
                               "MKL_PARDISO_OOC_KEEP_FILE": "0"}):
                 yield
@@ -472,6 +482,16 @@ def backward_error(norm: float, x: np.ndarray, r: np.ndarray, b: np.ndarray) -> 
     with np.errstate(divide="ignore", invalid="ignore"):
         eta = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.where(num > 0, np.inf, 0.0))
     return float(eta.max()) if eta.size else 0.0
+
+
+def ooc_path(folder: str) -> str:
+    """MKL_PARDISO_OOC_PATH for a folder: the folder itself, without a trailing separator (MKL adds
+    "/mkl_pardiso"; a path ending in a separator makes MKL 2026.2 write one byte past a heap buffer,
+    :meth:`KKTSystem._ooc_environment`)."""
+    path = folder.rstrip(os.sep)
+    if not path:
+        raise SolverError(f"PARDISO out of core needs a folder other than the file system's root, got {folder!r}")
+    return path
 
 
 #: pardiso-ooc: the part of the factor PARDISO keeps in memory [MB] (MKL_PARDISO_OOC_MAX_CORE_SIZE;

@@ -133,6 +133,45 @@ out["folder_gone"] = not os.path.exists(folder)
     assert out["folder_gone"]
 
 
+@needs_pardiso
+def test_the_out_of_core_folder_is_given_without_a_trailing_separator(tmp_path):
+    """MKL 2026.2 writes one byte past a heap buffer when MKL_PARDISO_OOC_PATH ends in a separator
+    (valgrind's memcheck: an invalid write of size 1 in ``mkl_pds_lp64_pardiso_ooc_read_cfg_file``
+    for "/tmp/x/", none for "/tmp/x"); that byte corrupted whatever the heap had next to it -- the
+    intermittent wrong solutions, swapped Python objects and aborts at exit of this file's runs
+    until 2026-11-27.  Every PARDISO call of an out-of-core system sees its folder without the
+    separator, an existing folder, where MKL puts its files (mkl_pardiso_*.bin)."""
+    out = _run(tmp_path, """
+seen = []
+real = sparse.environment
+def spy(values):
+    path = values.get("MKL_PARDISO_OOC_PATH")
+    if path is not None:
+        seen.append([path, os.path.isdir(path), sorted(os.listdir(path))])
+    return real(values)
+sparse.environment = spy
+K, C, g, f = system(plate(8))
+with KKTSystem(C, "pardiso-ooc") as kkt:
+    kkt.factor(K)
+    kkt.solve(f, g)
+out["seen"] = seen
+""")
+    seen = out["seen"]
+    assert len(seen) >= 3                                     # analysis, factorisation, solution
+    assert all(not p.endswith(os.sep) and is_dir for p, is_dir, _ in seen), seen
+    assert any(name.startswith("mkl_pardiso_") for _, _, files in seen for name in files), seen
+
+
+def test_ooc_path_drops_the_trailing_separator():
+    from graspdef.errors import SolverError
+    from graspdef.solve.sparse import ooc_path
+
+    assert ooc_path("/tmp/graspdef_pardiso_ooc_x/") == "/tmp/graspdef_pardiso_ooc_x"
+    assert ooc_path("/tmp/graspdef_pardiso_ooc_x") == "/tmp/graspdef_pardiso_ooc_x"
+    with pytest.raises(SolverError, match="root"):
+        ooc_path("/")
+
+
 def _solve_cli(tmp_path, path, backend: str) -> dict:
     """``graspdef solve PATH --backend BACKEND`` in a process of its own (the console script); its
     result.json, after requiring exit status 0."""
