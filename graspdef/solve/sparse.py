@@ -210,13 +210,11 @@ class KKTSystem:
         (``mkl_pds_lp64_pardiso_ooc_read_cfg_file``, in ``mkl_serv_sprintf_s``) writes one byte past
         a heap buffer -- found with valgrind's memcheck (an "Invalid write of size 1", 7 bytes after
         a 56-byte Python object) on a 900-unknown system; with the path "/tmp/x/" the same, with
-        "/tmp/x" or any path without the final "/" none.  The overwritten byte lands wherever the heap
-        puts the buffer's neighbour, and it explains every intermittent out-of-core failure seen
-        here (README "Out of core"): solutions off by 5e-5 to 2.1 in relative residual, Python
-        objects swapped (``float()`` of a PathSolver, an ``AttributeError`` inside pypardiso), aborts
-        at exit -- about 1 in 50-100 runs of tests/solve/test_kkt_out_of_core.py until 2026-11-27,
-        with or without the held thread count (which the held count had seemed to cure: 4 of 80 ->
-        0 of 80)."""
+        "/tmp/x" or any path without the final "/" none.  The overwritten byte lands wherever the
+        heap puts the buffer's neighbour.  Intermittent out-of-core failures remain after this fix
+        (README "Out of core": about 1 in 75 runs of tests/solve/test_kkt_out_of_core.py in two
+        loops side by side -- wrong solutions caught by the solve's check, Python objects
+        overwritten); their cause is open."""
         if self._ooc_dir is None:
             yield
             return
