@@ -327,7 +327,7 @@ def _limit_point_records(spec, sol, ref, record):
     lp = ref["limit_point"]
     if lp["load"] == "load_factor":
         cp = next((c for c in sol.critical_points if c["kind"].startswith("limit point")), None)
-        at = None if cp is None else next(p for p in sol.path if p.load_factor == cp["load_factor"])
+        at = None if cp is None else next((p for p in sol.path if p.load_factor == cp["load_factor"]), None)
         p, w = ((float("nan"), float("nan")) if at is None
                 else (at.load_factor, _path_quantity(spec, sol, at, lp["displacement"], ref)))
         record("limit load", lp["value"], p, (p - lp["value"]) / abs(lp["value"]))
