@@ -100,20 +100,25 @@ def axisym_cap(energy: str = "3d", pieces: int = 32, max_piece: float = 0.5) -> 
             "load_factors": lam.tolist(), "apex_deflection": w.tolist()}
 
 
+def cap_file(folder: Path, edge_length: float, refinements: int) -> Path:
+    """The benchmark file with another mesh (its geometry's edge_length and refinements), written
+    to ``folder``."""
+    text = re.sub(r"(?m)^edge_length = \S+", f"edge_length = {edge_length}", BENCH.read_text())
+    text = re.sub(r"(?m)^refinements = \S+", f"refinements = {refinements}", text)
+    path = Path(folder) / BENCH.name
+    path.write_text(text)
+    return path
+
+
 def shell3d_cap(edge_length: float, refinements: int) -> dict:
     """The benchmark file's cap at another mesh: its first located limit point and path."""
-    from dataclasses import replace
-
     from graspdef.problem.config import load_problem
     from graspdef.solve.nonlinear import path_options, solve_nonlinear
 
-    text = re.sub(r"(?m)^edge_length = \S+", f"edge_length = {edge_length}", BENCH.read_text())
-    text = re.sub(r"(?m)^refinements = \S+", f"refinements = {refinements}", text)
     with tempfile.TemporaryDirectory() as d:
-        (Path(d) / BENCH.name).write_text(text)
-        spec = load_problem(Path(d) / BENCH.name)
+        spec = load_problem(cap_file(Path(d), edge_length, refinements))
     t0 = time.perf_counter()
-    sol = solve_nonlinear(spec.problem, replace(path_options(spec.solver)), backend=spec.backend)
+    sol = solve_nonlinear(spec.problem, path_options(spec.solver), backend=spec.backend)
     seconds = time.perf_counter() - t0
     pts = [p for p in sol.path if p.kind != "refine"]
     cps = [c for c in sol.critical_points if c["kind"].startswith("limit point")]

@@ -109,7 +109,7 @@ def test_spherical_cap_with_too_few_cells_says_so():
         spherical_cap(100.0, 8.0 / 3.0, 1000.0, 4)
 
 
-def test_bench_takes_the_limit_point_the_path_located(tmp_path):
+def test_bench_takes_the_limit_point_the_path_located(tmp_path, study):
     """``[reference.limit_point] load = "load_factor"``: graspdef bench reports the path's located
     limit point (bracketed to 2^-12 of its arc step), not the parabola through the arc-length
     steps around it -- on 353 control vertices that parabola was +1.0 % off (0.654359) where the
@@ -118,11 +118,7 @@ def test_bench_takes_the_limit_point_the_path_located(tmp_path):
     ~6 s."""
     from graspdef.bench import run_nonlinear_benchmark
 
-    text = BENCH.read_text().replace("edge_length = 1.45 ", "edge_length = 5.8 ").replace(
-        "refinements = 4 ", "refinements = 2 ")
-    path = tmp_path / BENCH.name
-    path.write_text(text)
-    recs = {r["name"].split(" ", 1)[1]: r for r in run_nonlinear_benchmark(path)}
+    recs = {r["name"].split(" ", 1)[1]: r for r in run_nonlinear_benchmark(study.cap_file(tmp_path, *study.MESHES[0]))}
     assert set(recs) == {"limit load", "displacement at the limit load"}
     load = recs["limit load"]
     assert load["n_control"] == 97
