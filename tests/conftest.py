@@ -1,10 +1,27 @@
 """Process set-up of the test session: what ``graspdef`` does at start (graspdef.runtime), so the
 tests run the solvers as the command line does."""
+import os
+import shutil
+import tempfile
+
 from graspdef import runtime
+
+_CACHE = "GRASPDEF_CACHE_DIR"
 
 
 def pytest_configure(config):
     runtime.configure()
+    # graspdef.scans.cache: the session's control meshes in a folder of its own (not the user's
+    # ~/.cache), shared by xdist's workers (they inherit the environment) and removed at the end
+    if _CACHE not in os.environ:
+        os.environ[_CACHE] = config._graspdef_cache = tempfile.mkdtemp(prefix="graspdef_test_cache_")
+
+
+def pytest_unconfigure(config):
+    folder = getattr(config, "_graspdef_cache", None)
+    if folder:
+        shutil.rmtree(folder, ignore_errors=True)
+        os.environ.pop(_CACHE, None)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from ..errors import MeshError
 from ..geometry import TriMesh, validate_mesh
-from ..scans import control_mesh, load_scan, mid_surface
+from ..scans import mid_surface, scan_entry
+from ..scans.cache import cached_control_mesh
 from ..scans.manifest import ply_units, read_surface
 from ..shell.memory import check_memory
 from ..shell.model import Shell
@@ -14,7 +15,8 @@ from .data import ObjectSpec
 def outer_surface(spec: ObjectSpec) -> tuple[TriMesh, dict]:
     """The outer surface's control mesh [m] of ``spec`` and how it was made: the object's own
     ``control_mesh`` file (read as it is, its unit from the PLY header), or the control mesh of
-    the scan (graspdef.scans.control_mesh, ``spec.control_faces``, ``spec.remesh``, ``spec.relax``)."""
+    the scan (graspdef.scans.control_mesh, ``spec.control_faces``, ``spec.remesh``, ``spec.relax``;
+    read from the disk cache of graspdef.scans.cache when a run made it before)."""
     if spec.control_mesh is not None:
         units = ply_units(spec.control_mesh)
         if units is None:
@@ -23,7 +25,8 @@ def outer_surface(spec: ObjectSpec) -> tuple[TriMesh, dict]:
         v, f = read_surface(spec.control_mesh, units)
         validate_mesh(v, f, str(spec.control_mesh))
         return TriMesh(v, f), {"control_mesh": spec.control_mesh.name, "remesh": "given"}
-    outer, rep = control_mesh(load_scan(spec.scan), spec.control_faces, spec.remesh, relax=spec.relax)
+    entry = scan_entry(spec.scan)
+    outer, rep = cached_control_mesh(entry.file(), entry.units, spec.control_faces, spec.remesh, relax=spec.relax)
     return outer, {"scan": spec.scan, "remesh": getattr(rep, "method", spec.remesh)}
 
 

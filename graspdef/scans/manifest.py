@@ -14,7 +14,6 @@ from os import PathLike
 from pathlib import Path
 
 import numpy as np
-import trimesh
 
 from graspdef.config import Table, read_toml
 from graspdef.errors import MeshError, ProblemError
@@ -174,6 +173,8 @@ def read_surface(path: str | PathLike, units: str) -> tuple[np.ndarray, np.ndarr
     path = Path(path)
     if not path.is_file():
         raise ProblemError(f"scan file not found: {path}")
+    import trimesh  # here, not at import: ~0.5 s, and a run whose control mesh is cached reads no scan
+
     try:
         loaded = trimesh.load(path, process=False)
     except Exception as exc:  # trimesh raises many exception types for unreadable files

@@ -26,7 +26,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import trimesh
 
 from graspdef.errors import MeshError, ProblemError
 from graspdef.geometry import TriMesh, icosphere, is_closed, validate_mesh
@@ -86,11 +85,15 @@ def clean_scan(mesh: TriMesh) -> TriMesh:
 
 def _closest_distance(points: np.ndarray, mesh: TriMesh) -> np.ndarray:
     """Unsigned distance [m] from each point to the triangle mesh (trimesh, float64)."""
+    import trimesh  # here, not at import (start-up: a run whose control mesh is cached needs none)
+
     tm = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False)
     return np.asarray(trimesh.proximity.closest_point(tm, points)[1], dtype=np.float64)
 
 
 def _check(mesh: TriMesh, scan: TriMesh, method: str, euler_scan: int) -> ControlMeshReport:
+    import trimesh
+
     name = f"control mesh ({method})"
     validate_mesh(mesh.vertices, mesh.faces, name)
     if not is_closed(mesh.faces):
@@ -113,6 +116,8 @@ def _check(mesh: TriMesh, scan: TriMesh, method: str, euler_scan: int) -> Contro
 
 
 def _project(scan: TriMesh, n_faces: int) -> TriMesh:
+    import trimesh
+
     level = math.log(n_faces / 20, 4)
     if n_faces < 20 or abs(level - round(level)) > 1e-9:
         raise ProblemError(f"method 'project' makes icospheres: n_faces must be 20 * 4**k "
@@ -157,6 +162,8 @@ def _isotropic(scan: TriMesh, n_faces: int) -> TriMesh:
         import pymeshlab  # lazy: only this method needs it
     except ImportError as exc:
         raise MeshError(f"method 'isotropic' needs pymeshlab ({exc}): pip install 'graspdef[objects]'") from exc
+    import trimesh
+
     area = float(trimesh.Trimesh(scan.vertices, scan.faces, process=False).area)
     length = math.sqrt(4.0 * area / (math.sqrt(3.0) * n_faces))     # n_faces equilateral triangles
     ms = pymeshlab.MeshSet()
@@ -169,6 +176,7 @@ def _isotropic(scan: TriMesh, n_faces: int) -> TriMesh:
 def _relax(mesh: TriMesh, scan: TriMesh, iterations: int, step: float = 0.5) -> TriMesh:
     """Tangential umbrella smoothing, each step projected back onto the scan: evens out the
     triangles of a decimated mesh (connectivity unchanged)."""
+    import trimesh
     from scipy.sparse import coo_matrix
 
     tm_scan = trimesh.Trimesh(scan.vertices, scan.faces, process=False)
@@ -253,11 +261,51 @@ def control_mesh(scan: TriMesh, n_faces: int, method: str = "auto", relax: int =
     return mesh, _check(mesh, scan, method, euler_scan)
 
 
+def _unit(vectors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows scaled to unit length (rows of length <= 1e-13 left as they are) and which were
+    longer -- trimesh.util.unitize's operations, so that the results equal trimesh's to the bit."""
+    norm = np.sqrt(np.dot(vectors * vectors, [1.0] * vectors.shape[1]))
+    valid = norm > 1e-13
+    norm[valid] **= -1
+    return vectors * norm.reshape((-1, 1)), valid
+
+
+def face_unit_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Unit face normals (m, 3), zero for a degenerate face: trimesh's ``face_normals`` computed
+    the same way (equal to the bit, tests/scans/test_scan_remesh.py) without importing trimesh."""
+    tri = np.asarray(vertices, np.float64)[np.asarray(faces, np.int64)]
+    edges = tri[:, 1:, :] - tri[:, :2, :]
+    unit, valid = _unit(np.cross(edges[:, 0], edges[:, 1]))
+    unit[~valid] = 0.0
+    return unit
+
+
+def face_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Interior angles (m, 3) [rad] at the faces' corners, all zero for a face with an angle below
+    1e-8: trimesh's ``face_angles`` computed the same way (equal to the bit)."""
+    tri = np.asarray(vertices, np.float64)[np.asarray(faces, np.int64)]
+    u = _unit(tri[:, 1] - tri[:, 0])[0]
+    v = _unit(tri[:, 2] - tri[:, 0])[0]
+    w = _unit(tri[:, 2] - tri[:, 1])[0]
+    out = np.zeros((len(tri), 3), dtype=np.float64)
+    out[:, 0] = np.arccos(np.clip(np.dot(u * v, [1.0] * 3), -1, 1))
+    out[:, 1] = np.arccos(np.clip(np.dot(-u * w, [1.0] * 3), -1, 1))
+    out[:, 2] = np.pi - out[:, 0] - out[:, 1]
+    out[(out < 1e-8).any(axis=1), :] = 0.0
+    return out
+
+
+def enclosed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """Signed volume [m^3] enclosed by a closed triangle mesh (positive for outward normals): the
+    sum of the tetrahedra (origin, a, b, c), a . (b x c) / 6."""
+    tri = np.asarray(vertices, np.float64)[np.asarray(faces, np.int64)]
+    return float(np.einsum("ij,ij->", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])) / 6.0)
+
+
 def vertex_normals(mesh: TriMesh) -> np.ndarray:
     """Angle-weighted unit vertex normals (pseudo-normals), shape (n, 3)."""
-    tm = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False)
-    fn = np.asarray(tm.face_normals)
-    w = np.asarray(tm.face_angles)
+    fn = face_unit_normals(mesh.vertices, mesh.faces)
+    w = face_angles(mesh.vertices, mesh.faces)
     n = np.zeros_like(mesh.vertices)
     for i in range(3):
         np.add.at(n, mesh.faces[:, i], fn * w[:, i:i + 1])
@@ -283,16 +331,16 @@ def mid_surface(outer: TriMesh, thickness: float) -> TriMesh:
     if not (math.isfinite(t) and t > 0):
         raise ProblemError(f"thickness must be a positive finite number, got {thickness!r}")
     validate_mesh(outer.vertices, outer.faces, "outer surface")
-    tm = trimesh.Trimesh(outer.vertices, outer.faces, process=False)
-    if is_closed(outer.faces) and tm.volume <= 0:
+    closed = is_closed(outer.faces)
+    volume = enclosed_volume(outer.vertices, outer.faces) if closed else None
+    if closed and volume <= 0:
         raise MeshError("outer surface: normals point inward (negative enclosed volume); "
                         "flip the faces")
     mid = TriMesh(outer.vertices - 0.5 * t * vertex_normals(outer), outer.faces)
-    before = np.asarray(tm.face_normals)
-    after = np.asarray(trimesh.Trimesh(mid.vertices, mid.faces, process=False).face_normals)
+    before = face_unit_normals(outer.vertices, outer.faces)
+    after = face_unit_normals(mid.vertices, mid.faces)
     flipped = np.flatnonzero(np.einsum("ij,ij->i", before, after) <= 0.0)
-    if is_closed(outer.faces) and not 0 < trimesh.Trimesh(mid.vertices, mid.faces,
-                                                          process=False).volume < tm.volume:
+    if closed and not 0 < enclosed_volume(mid.vertices, mid.faces) < volume:
         raise MeshError(f"mid-surface offset by {t / 2 * 1e3:.3g} mm turns the surface inside "
                         "out (half the thickness exceeds the object's radius)")
     if flipped.size:

@@ -53,13 +53,17 @@ def test_bad_input_leaves_nothing(tmp_path, capsys):
 def test_open_scan_is_refused(monkeypatch, tmp_path):
     """A scan that is not watertight cannot give a closed shell: MeshError before any output."""
     from graspdef.errors import MeshError
-    from graspdef.geometry import TriMesh, icosphere
+    from types import SimpleNamespace
+
+    from graspdef.geometry import icosphere, save_ply
     from graspdef.objects import build
     from graspdef.pipeline import grasp as gp
 
     ball = icosphere(radius=0.03, subdivisions=3)
     keep = ball.vertices[ball.faces].mean(axis=1)[:, 2] > -0.01        # cut the bottom off
-    monkeypatch.setattr(build, "load_scan", lambda scan_id: TriMesh(ball.vertices, ball.faces[keep]))
+    open_scan = tmp_path / "open_scan.ply"
+    save_ply(open_scan, ball.vertices, ball.faces[keep], units="m")
+    monkeypatch.setattr(build, "scan_entry", lambda scan_id: SimpleNamespace(file=lambda: open_scan, units="m"))
     out = tmp_path / "run"
     with pytest.raises(MeshError, match="not closed"):
         gp.run_grasp("tennis_ball", 10.0, "point", "linear", out)

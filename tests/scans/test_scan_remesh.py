@@ -133,3 +133,23 @@ def test_mid_surface_refusals():
     with pytest.raises(MeshError, match="normals point inward"):
         mid_surface(inside_out, 1e-3)
     assert is_closed(sphere.faces)
+
+
+def test_normals_angles_and_volume_are_trimeshs(ball):
+    """graspdef's face normals and angles (what the mid-surface offset uses, without importing
+    trimesh) equal trimesh's to the bit on the tennis-ball scan and on a mesh with a degenerate
+    face (zero normal, zero angles); the enclosed volume trimesh's to 1e-12."""
+    from graspdef.scans.remesh import enclosed_volume, face_angles, face_unit_normals
+
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [2, 0, 0], [0.3, 0.2, 0.9]], float)
+    f = np.array([[0, 1, 2], [0, 1, 3], [1, 2, 4]])
+    for vv, ff in ((ball.vertices, ball.faces), (v, f)):
+        tm = trimesh.Trimesh(vv, ff, process=False)
+        assert np.array_equal(face_unit_normals(vv, ff), tm.face_normals)
+        assert np.array_equal(face_angles(vv, ff), tm.face_angles)
+    assert not face_unit_normals(v, f)[1].any() and not face_angles(v, f)[1].any()
+    tm = trimesh.Trimesh(ball.vertices, ball.faces, process=False)
+    np.testing.assert_allclose(enclosed_volume(ball.vertices, ball.faces), tm.volume, rtol=1e-12)
+    sph = icosphere(0.02, 3)
+    np.testing.assert_allclose(enclosed_volume(sph.vertices, sph.faces),
+                               trimesh.Trimesh(sph.vertices, sph.faces).volume, rtol=1e-12)
