@@ -161,7 +161,6 @@ class KKTSystem:
         self._ooc_dir: str | None = None  # pardiso-ooc: the folder of PARDISO's factor files
         self.ooc_core_mb = OOC_CORE_MB    # pardiso-ooc: the factor's part held in memory [MB]
         self._ooc_threads: int | None = None   # pardiso-ooc: MKL's thread count, fixed at the first call
-        self.ooc_retries = 0              # pardiso-ooc: factorisations refused for too little memory (error -9)
         self.C = C.tocsr()
         self.m = self.C.shape[0]
         self._solver = None
@@ -259,14 +258,16 @@ class KKTSystem:
         new_pattern = self._map is None or not self._map.matches(K)
         upper_map = _UpperMap(K, self.C) if new_pattern else self._map
         U = upper_map.upper(K, self.scale)
-        if self.backend == "pardiso-ooc" and self._solver is not None and (analyse or new_pattern):
-            # out of core, a second analysis on the same PARDISO handle crashes the process in the
-            # factorisation after it (a nonlinear path's tangent fills structural zeros of the rest
-            # stiffness: 30,755 -> 55,359 non-zeros on the cantilever, then a segmentation fault in
-            # graspdef solve --backend pardiso-ooc until 2026-11-27): a fresh handle and folder for
-            # every analysis
-            self.close()
+        if self.backend == "pardiso-ooc" and self._solver is not None and new_pattern:
+            # out of core, one PARDISO handle and one analysis per process (require_one_ooc_handle):
+            # a pattern inside the analysed one is factorised on it (its missing entries zero),
+            # any other is refused
+            K, upper_map = self._on_analysed_pattern(K), self._map
+            new_pattern = False
+            U = upper_map.upper(K, self.scale)
         if self._solver is None:
+            if self.backend == "pardiso-ooc":
+                require_one_ooc_handle()
             self._solver = _new_pardiso(-2)
             ooc = {60: 2} if self.backend == "pardiso-ooc" else {}
             if ooc and self._ooc_dir is None:
@@ -291,23 +292,29 @@ class KKTSystem:
             if self._ooc_dir is None or getattr(exc, "value", None) != -9:
                 raise
             # -9: the in-memory part allowed is below what PARDISO's out-of-core mode needs for this
-            # matrix although its analysis said otherwise (_fit_ooc_core; not seen since): double
-            # it, analyse again
-            self.close()
-            self.ooc_retries += 1
-            self.ooc_core_mb *= 2
-            have = _available_mb()
-            if have is not None and self.ooc_core_mb > have:
-                raise SolverError(f"PARDISO out of core needs more than {self.ooc_core_mb // 2} MB of memory for "
-                                  f"this matrix and {have} MB are free: the problem is too large for this "
-                                  "machine") from None
-            log.info("PARDISO out of core: more memory needed, retrying with %d MB", self.ooc_core_mb)
-            self._factor_pardiso(True)
-            return
+            # matrix although its analysis said otherwise (_fit_ooc_core; not seen since 2026-11-27).
+            # A second handle with more memory is what corrupted memory (require_one_ooc_handle)
+            raise SolverError(f"PARDISO out of core: {self.ooc_core_mb} MB in memory were too few for this "
+                              "matrix's factorisation (error -9) although its analysis asked for no more; "
+                              "raise graspdef.solve.sparse.OOC_CORE_MB and run again") from None
         self.n_factor += 1
         self._U = U
         self.perturbed = int(s.get_iparm(14))
         self.n_negative = int(s.get_iparm(23))
+
+    def _on_analysed_pattern(self, K: sp.csr_matrix) -> sp.csr_matrix:
+        """pardiso-ooc: ``K`` on the analysed pattern (its entries there, explicit zeros elsewhere),
+        or SolverError if K has an entry outside it."""
+        a = self._map
+        ref = sp.csr_matrix((np.zeros(a.indices.size), a.indices, a.indptr), shape=K.shape)
+        union = union_sum(K, ref)
+        if not a.matches(union):
+            raise SolverError(
+                f"PARDISO out of core: the matrix's sparsity pattern changed ({a.indices.size:,} analysed non-zeros, "
+                f"{union.nnz:,} now), which needs a second analysis, and out of core that needs a second "
+                "PARDISO handle in the process (refused: README, 'Out of core'); solve this problem in core "
+                "(backend 'pardiso') or with a fixed pattern")
+        return union
 
     def _fit_ooc_core(self, need_kb: int) -> None:
         """pardiso-ooc, after an analysis: raise the factor's part held in memory to what PARDISO's
@@ -358,6 +365,11 @@ class KKTSystem:
         the standard matching, switched to at one point, solved a later tangent to a residual of
         1e-2 that the defaults solve to 3e-12."""
         if not self._pardiso or self._solver is None:
+            return False
+        if self.backend == "pardiso-ooc":
+            # another variant needs a fresh handle, which out of core is not allowed
+            # (require_one_ooc_handle): the check's failure stands
+            log.info("KKT: no refactorisation with other settings out of core (one PARDISO handle per process)")
             return False
         n_var = 1 + len(_PARDISO_FALLBACKS)
         nxt = next(((self.variant + k) % n_var for k in range(1, n_var) if (self.variant + k) % n_var not in self._tried), None)
@@ -480,6 +492,40 @@ def backward_error(norm: float, x: np.ndarray, r: np.ndarray, b: np.ndarray) -> 
     with np.errstate(divide="ignore", invalid="ignore"):
         eta = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.where(num > 0, np.inf, 0.0))
     return float(eta.max()) if eta.size else 0.0
+
+
+def union_sum(A: sp.spmatrix, B: sp.spmatrix) -> sp.csr_matrix:
+    """A + B on the union of their patterns, explicit zeros kept (scipy's sum drops them), with
+    sorted indices."""
+    a, b = A.tocoo(), B.tocoo()
+    out = sp.coo_matrix((np.concatenate([a.data, b.data]), (np.concatenate([a.row, b.row]), np.concatenate([a.col, b.col]))),
+                        shape=A.shape).tocsr()
+    out.sum_duplicates()
+    return out
+
+
+#: whether this process has created its out-of-core PARDISO handle (require_one_ooc_handle)
+_ooc_handle_created = False
+
+
+def require_one_ooc_handle() -> None:
+    """Allow the process's first out-of-core PARDISO handle; refuse any further one (SolverError).
+
+    MKL 2026.2's out-of-core mode keeps state of its own across handles, and processes that made a
+    second handle after freeing the first corrupted memory: in standalone processes, 3 of 417 with
+    two to ten handles each (the cantilever's path re-analysed on a fresh handle: 2 segmentation
+    faults in 281; ten plate solves on ten handles: an ``AttributeError`` inside pypardiso in 136)
+    against 0 of 1,036 with one handle (900 plate solves; ten factorisations on one handle, 136),
+    and in 3 of 260 processes that re-created a handle after error -9 (README, "Out of core").  One
+    handle per process, analysed once: a pattern change inside the analysed pattern is factorised
+    on it, any other is refused, as are PARDISO's fallback settings (a fresh handle each).  State
+    of the process, like MKL's own: ``graspdef solve --backend pardiso-ooc`` is one process."""
+    global _ooc_handle_created
+    if _ooc_handle_created:
+        raise SolverError("PARDISO out of core (backend 'pardiso-ooc') allows one solver per process: a second "
+                          "one in the same process corrupted memory (MKL 2026.2; README, 'Out of core'); run each "
+                          "out-of-core solve in a process of its own, e.g. graspdef solve PROBLEM --backend pardiso-ooc")
+    _ooc_handle_created = True
 
 
 def ooc_path(folder: str) -> str:
