@@ -160,7 +160,6 @@ class KKTSystem:
         self._pardiso = backend in ("pardiso", "pardiso-ooc")
         self._ooc_dir: str | None = None  # pardiso-ooc: the folder of PARDISO's factor files
         self.ooc_core_mb = OOC_CORE_MB    # pardiso-ooc: the factor's part held in memory [MB]
-        self._ooc_threads: int | None = None   # pardiso-ooc: MKL's thread count, fixed at the first call
         self.C = C.tocsr()
         self.m = self.C.shape[0]
         self._solver = None
@@ -197,12 +196,7 @@ class KKTSystem:
     def _ooc_environment(self):
         """For pardiso-ooc, around every PARDISO call (nothing for the in-core backends): MKL reads
         where to put its factor files and how much of the factor to keep in memory from the
-        environment (set here and restored after: no lasting change to the process); and MKL's
-        thread count is held at that of the first out-of-core call (``MKL_Set_Num_Threads_Local``,
-        the C interface).  MKL sizes its out-of-core buffers by the OpenMP thread count and requires
-        it unchanged from the analysis to the factorisation and solution phases (Intel, "How to use
-        Intel MKL OOC PARDISO"), while numba's OpenMP kernels run between those phases in the same
-        runtime (GNU OpenMP).
+        environment (set here and restored after: no lasting change to the process).
 
         The folder is given **without a trailing separator**: MKL 2026.2 appends "/mkl_pardiso" to
         the path itself, and for a path that ends in "/" its configuration reader
@@ -210,24 +204,15 @@ class KKTSystem:
         a heap buffer -- found with valgrind's memcheck (an "Invalid write of size 1", 7 bytes after
         a 56-byte Python object) on a 900-unknown system; with the path "/tmp/x/" the same, with
         "/tmp/x" or any path without the final "/" none.  The overwritten byte lands wherever the
-        heap puts the buffer's neighbour.  Intermittent out-of-core failures remain after this fix
-        (README "Out of core": about 1 in 75 runs of tests/solve/test_kkt_out_of_core.py in two
-        loops side by side -- wrong solutions caught by the solve's check, Python objects
-        overwritten); their cause is open."""
+        heap puts the buffer's neighbour.  MKL runs on its sequential layer for out-of-core solves
+        (:func:`require_sequential_mkl`) with one handle per process (:func:`require_one_ooc_handle`)."""
         if self._ooc_dir is None:
             yield
             return
-        lib = self._solver.libmkl
-        if self._ooc_threads is None:
-            self._ooc_threads = int(lib.MKL_Get_Max_Threads())
-        prev = lib.MKL_Set_Num_Threads_Local(ctypes.c_int(self._ooc_threads))
-        try:
-            with environment({"MKL_PARDISO_OOC_PATH": ooc_path(self._ooc_dir),
-                              "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(self.ooc_core_mb),
-                              "MKL_PARDISO_OOC_KEEP_FILE": "0"}):
-                yield
-        finally:
-            lib.MKL_Set_Num_Threads_Local(ctypes.c_int(prev))
+        with environment({"MKL_PARDISO_OOC_PATH": ooc_path(self._ooc_dir),
+                          "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(self.ooc_core_mb),
+                          "MKL_PARDISO_OOC_KEEP_FILE": "0"}):
+            yield
 
     def factor(self, K: sp.spmatrix, analyse: bool = False) -> None:
         """Factor the KKT matrix of ``K``; ``analyse`` forces a fresh ordering/matching.  A
@@ -266,9 +251,11 @@ class KKTSystem:
             new_pattern = False
             U = upper_map.upper(K, self.scale)
         if self._solver is None:
+            solver = _new_pardiso(-2)
             if self.backend == "pardiso-ooc":
+                require_sequential_mkl(solver.libmkl)
                 require_one_ooc_handle()
-            self._solver = _new_pardiso(-2)
+            self._solver = solver
             ooc = {60: 2} if self.backend == "pardiso-ooc" else {}
             if ooc and self._ooc_dir is None:
                 self._ooc_dir = tempfile.mkdtemp(prefix="graspdef_pardiso_ooc_")
@@ -502,6 +489,34 @@ def union_sum(A: sp.spmatrix, B: sp.spmatrix) -> sp.csr_matrix:
                         shape=A.shape).tocsr()
     out.sum_duplicates()
     return out
+
+
+#: MKL's code of its sequential threading layer (mkl_set_threading_layer: INTEL 0, SEQUENTIAL 1, GNU 3)
+MKL_THREADING_SEQUENTIAL = 1
+
+
+def require_sequential_mkl(lib) -> None:
+    """Put MKL (``lib``, the loaded ``libmkl_rt``) on its sequential threading layer for an
+    out-of-core solve, or raise SolverError if the process has already called MKL on a threaded one.
+
+    MKL chooses its layer at its first call in a process and keeps it (``MKL_Set_Threading_Layer``
+    returns the layer in effect).  Intel requires the OpenMP thread count of PARDISO's out-of-core
+    mode unchanged from the analysis to the solution ("How to use OOC PARDISO").  On a busy machine
+    the threaded out-of-core factorisation came out wrong although graspdef held MKL's thread count
+    (``MKL_Set_Num_Threads_Local``; MKL's dynamic adjustment of its threads to the load is a
+    suspect, not shown): the 12 x 12 plate's factor, every time the same way (a residual of
+    4.96e-2, caught by the solve's check), in about 1 of 60 runs of
+    tests/solve/test_kkt_out_of_core.py in two loops side by side -- even with one handle per
+    process -- and in none of 295 runs on the sequential layer (README, "Out of core").  In-core
+    PARDISO keeps the threaded layer, so one process cannot hold both: an out-of-core solve needs a
+    process that has not called MKL before (as ``graspdef solve --backend pardiso-ooc`` is)."""
+    layer = int(lib.MKL_Set_Threading_Layer(ctypes.c_int(MKL_THREADING_SEQUENTIAL)))
+    if layer != MKL_THREADING_SEQUENTIAL:
+        raise SolverError(
+            "PARDISO out of core (backend 'pardiso-ooc') runs on MKL's sequential threading layer, which "
+            "must be chosen before MKL's first call; this process has already called MKL on its threaded "
+            f"layer (code {layer}, e.g. an in-core PARDISO solve): run the out-of-core solve in a process "
+            "of its own, e.g. graspdef solve PROBLEM --backend pardiso-ooc")
 
 
 #: whether this process has created its out-of-core PARDISO handle (require_one_ooc_handle)

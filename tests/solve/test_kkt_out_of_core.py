@@ -165,6 +165,44 @@ out["seen"] = seen
 
 
 @needs_pardiso
+def test_out_of_core_runs_on_mkls_sequential_layer_and_only_there(tmp_path):
+    """An out-of-core solve puts MKL on its sequential threading layer (asked for GNU OpenMP
+    afterwards, MKL answers with the layer in effect, 1, and one thread); in a process whose MKL
+    already runs threaded (an in-core PARDISO solve first) an out-of-core system is refused with one
+    line before any out-of-core call (graspdef.solve.sparse.require_sequential_mkl: threaded, the
+    out-of-core factor came out wrong about once in 60 runs of this file on a busy machine)."""
+    out = _run(tmp_path, """
+K, C, g, f = system(plate(8))
+with KKTSystem(C, "pardiso-ooc") as kkt:
+    kkt.factor(K)
+    out["rel"] = kkt.solve(f, g)[2]
+    lib = kkt._solver.libmkl
+    out["layer"] = int(lib.MKL_Set_Threading_Layer(3))
+    out["threads"] = int(lib.MKL_Get_Max_Threads())
+""")
+    assert out["layer"] == 1 and out["threads"] == 1 and out["rel"] <= 1e-8
+    out = _run(tmp_path, """
+import tempfile
+from graspdef.errors import SolverError
+tempfile.tempdir = sys.argv[1]                  # an out-of-core folder would go here
+K, C, g, f = system(plate(8))
+with KKTSystem(C, "pardiso") as kkt:
+    kkt.factor(K)
+    out["rel"] = kkt.solve(f, g)[2]
+try:
+    with KKTSystem(C, "pardiso-ooc") as kkt:
+        kkt.factor(K)
+    out["error"] = None
+except SolverError as exc:
+    out["error"] = str(exc)
+out["left"] = sorted(n for n in os.listdir(sys.argv[1]) if n.startswith("graspdef_pardiso_ooc_"))
+""")
+    assert out["rel"] <= 1e-8
+    assert "sequential threading layer" in out["error"] and "process of its own" in out["error"], out
+    assert "\n" not in out["error"] and out["left"] == []
+
+
+@needs_pardiso
 def test_one_out_of_core_solver_per_process(tmp_path):
     """A second out-of-core system in a process is refused with one line before it calls PARDISO
     (MKL 2026.2 corrupted memory in processes that made a second out-of-core handle:
