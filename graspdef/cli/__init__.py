@@ -150,10 +150,11 @@ def console() -> None:
     numba's llvmlite, or a segfault; measured: 1 of 60 processes with two out-of-core solvers,
     1 of 30 ``graspdef solve`` runs in the test suite, README "Out of core"), which turned a
     finished run's status 0 into -6.  Everything the run writes is closed before (its files, the
-    solver's temporary folder).  Those crashes were measured before 2026-11-27, when one cause of
-    memory corruption was found and avoided (MKL wrote one byte past a heap buffer for an
-    out-of-core folder given with a trailing separator, graspdef.solve.sparse.ooc_path); other
-    intermittent out-of-core failures remain (README "Out of core"), and the guard stays."""
+    solver's temporary folder).  Those crashes were measured before 2026-11-27, when three causes of
+    memory corruption were found and avoided (a one-byte heap overflow in MKL for a folder given
+    with a trailing separator, graspdef.solve.sparse.ooc_path; a second out-of-core handle in a
+    process, require_one_ooc_handle; MKL's threads, require_sequential_mkl: README "Out of
+    core"); the guard stays, as it costs nothing."""
     rc, args = _main(None)
     if getattr(args, "end_process", False):
         from ..runtime import end_process

@@ -4,17 +4,15 @@ does not fit (README "Speed": the 100k pinched cylinder).  Invariant: the soluti
 1e-10, the residual check passes, the inertia is that of the stable state; the files and the
 process's environment are left as they were.
 
-Each check runs in a fresh interpreter with at most three out-of-core solvers: MKL's out-of-core
-mode (2026.2) has been seen to crash a process at exit and to overwrite memory (README, "Out of
-core"; one cause, a one-byte heap overflow in MKL for a folder path ending in a separator, is
-avoided since 2026-11-27, not all), which must not take a test worker down with it; those interpreters end with os._exit once their answer is printed, as
-``graspdef solve`` does after an out-of-core solve (graspdef.cli.console).
+Each check runs in a fresh interpreter: a process holds one out-of-core solver, on MKL's sequential
+layer, and no in-core PARDISO solver (graspdef.solve.sparse.require_one_ooc_handle and
+require_sequential_mkl: a second out-of-core handle corrupted memory, and MKL's threads gave a
+wrong out-of-core factor on a busy machine, together about 1 in 75 runs of this file until
+2026-11-27; README, "Out of core").  Those interpreters end with os._exit once their answer is
+printed, as ``graspdef solve`` does after an out-of-core solve (graspdef.cli.console).
 
-The references are SuperLU's, and no process mixes in-core and out-of-core PARDISO solvers: mixed
-in one process, 2 of 80 solves of the 40 x 40 plate under a random load (of either kind) came out
-1.4e-3 and 2.5e-3 of max |u| away from SuperLU's, and this file's comparisons flipped in 4 of 80
-runs; in-core alone (160 solves) and out-of-core alone (80) agreed with SuperLU to 3.5e-12
-(README, "Out of core").  The right-hand sides are the plate's own load (a centre point load)."""
+The references are SuperLU's.  The right-hand sides are the plate's own load (a centre point
+load)."""
 import json
 import os
 import subprocess
@@ -141,8 +139,9 @@ def test_the_out_of_core_folder_is_given_without_a_trailing_separator(tmp_path):
     (valgrind's memcheck: an invalid write of size 1 in ``mkl_pds_lp64_pardiso_ooc_read_cfg_file``
     for "/tmp/x/", none for "/tmp/x"); that byte corrupts whatever the heap has next to it.  Every
     PARDISO call of an out-of-core system sees its folder without the separator, an existing
-    folder, where MKL puts its files (mkl_pardiso_*.bin).  (Other intermittent out-of-core
-    failures remain, about 1 in 75 runs of this file: README "Out of core".)"""
+    folder, where MKL puts its files (mkl_pardiso_*.bin).  (The failures that remained after this
+    fix had two other causes: test_one_out_of_core_solver_per_process and
+    test_out_of_core_runs_on_mkls_sequential_layer_and_only_there.)"""
     out = _run(tmp_path, """
 seen = []
 real = sparse.environment
@@ -325,13 +324,12 @@ def test_graspdef_solve_out_of_core(tmp_path):
 
 @needs_pardiso
 def test_graspdef_solve_out_of_core_follows_a_nonlinear_path(tmp_path):
-    """A nonlinear path out of core: its tangents fill structural zeros of the flat plate's rest
-    stiffness (the cantilever rolled up by an end moment, to 0.1 of it in two steps: 30,755 -> 55,359
-    non-zeros), so PARDISO analyses a second pattern -- on the same handle, out of core, that crashed
-    the process in the next factorisation (segmentation fault, exit -11, until 2026-11-27; a path
-    whose tangents keep the rest stiffness's pattern, e.g. the 8 x 8 plate, did not crash).  Now
-    each analysis gets a fresh handle: the run completes with the in-core path's tip displacement
-    (to 1e-9 of it)."""
+    """A nonlinear path out of core (the cantilever rolled up by an end moment, to 0.1 of it in two
+    steps): the run completes with the in-core path's tip displacement (to 1e-9 of it).  Its
+    tangents used to fill the flat plate's exact zeros after the first step (31,203 -> 55,359
+    non-zeros), and a second analysis crashed the process on the same handle (segmentation fault)
+    and, on a fresh handle, corrupted memory in 2 of 281 processes; now the tangent keeps one
+    pattern from the start (test_a_flat_shells_tangent_keeps_its_pattern) and one handle serves."""
     text = (ROOT / "benchmarks" / "nonlinear" / "cantilever_moment.toml").read_text()
     path = tmp_path / "cantilever.toml"
     path.write_text(text.replace("steps = 20", "steps = 2\nmax_load = 0.1"))
@@ -341,6 +339,27 @@ def test_graspdef_solve_out_of_core_follows_a_nonlinear_path(tmp_path):
         assert rec["convergence"]["completed"]
         w[backend] = rec["probes"]["tip"]["displacement"][0]
     assert w["pardiso-ooc"] == pytest.approx(w["pardiso"], rel=1e-9, abs=0)
+
+
+def test_a_flat_shells_tangent_keeps_its_pattern():
+    """The cantilever's tangent (shell + end moment + clamp) at rest, where the flat shell's Hessian
+    has exact zeros, has the pattern it has bent: the equilibrium sums its terms on the union of
+    their patterns with explicit zeros kept (graspdef.solve.sparse.union_sum; scipy's sum dropped
+    them, 31,203 against 55,359 non-zeros), and the values are the sum's."""
+    import numpy as np
+
+    from graspdef.problem.config import load_problem
+    from graspdef.solve.equilibrium import Equilibrium
+
+    eq = Equilibrium(load_problem(ROOT / "benchmarks" / "nonlinear" / "cantilever_moment.toml").problem, backend="superlu")
+    u = 1e-4 * np.random.default_rng(0).standard_normal(eq.X.size)
+    H0, H1 = eq.evaluate(np.zeros_like(u), 0.05).hessian, eq.evaluate(u, 0.05).hessian
+    assert H0.nnz == H1.nnz and np.array_equal(H0.indptr, H1.indptr) and np.array_equal(H0.indices, H1.indices)
+    assert (H0.data == 0).sum() > 0.3 * H0.nnz                       # the rest state's exact zeros, kept
+    parts = eq.evaluate(np.zeros_like(u), 0.05, keep_terms=True).terms
+    total = sum(p.hessian.toarray() for p in parts if p.hessian is not None)
+    assert np.array_equal(H0.toarray(), total)
+    eq.close()
 
 
 def test_the_backend_is_a_problem_file_setting(tmp_path):
