@@ -89,7 +89,7 @@ def _read(file: Path, key: str) -> tuple[TriMesh, ControlMeshReport] | None:
                 raise ValueError("key or units do not match")
             mesh = TriMesh(np.array(z["vertices"], np.float64), np.array(z["faces"], np.int64))
             report = ControlMeshReport(**json.loads(str(z["report"])))
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):     # not cached (or no cache folder: _write says so)
         return None
     except Exception as exc:   # a damaged or foreign file: recompute and replace it
         log.warning("control-mesh cache: %s unreadable (%s); remeshing", file, exc)

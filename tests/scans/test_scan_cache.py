@@ -100,6 +100,7 @@ def test_unwritable_cache_warns_and_computes(blob, tmp_path, monkeypatch, caplog
     with caplog.at_level(logging.WARNING, logger="graspdef.scans.cache"):
         mesh, rep = cached_control_mesh(blob, "mm", 80, "project")
     assert "cannot write" in caplog.text and mesh.n_faces == 80 and rep.method == "project"
+    assert len(caplog.records) == 1                         # one line, not also "unreadable"
 
 
 def test_errors_are_control_meshs(tmp_path, monkeypatch):
