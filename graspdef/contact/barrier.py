@@ -190,17 +190,21 @@ class FingerContact(TermBase):
         order 0: value only, 1: + gradient, 2: + B_ss and B_xs, 3: + B_xx.  Only the samples
         within the barrier's reach (d < dhat, including any at d <= 0, where b = +inf) enter."""
         key = getattr(self, "_key", None)
+        window = None                       # the advance's final window: only its samples can be active
         if s_at is not None:                                    # a given advance (the first touch)
             s = s_at
         elif key is not None and key[1] == F and np.array_equal(key[0], x):
-            s = key[2]
+            s, window = key[2], key[3]
         else:
             s = self.advance(x, F)
-            self._key = (x.copy(), F, s)
+            window = self._cond.window
+            self._key = (x.copy(), F, s, window)
         P = self._ops.points(x)
-        d, n, _, _ = self._obs.along(P, s * self._e, self._e)
-        act = np.flatnonzero(d < self._dh)
-        d, n, P = d[act], n[act], P[act] - s * self._e
+        cand = self._cond.active_candidates(s, window)
+        d, n, _, _ = self._obs.along(P if cand is None else P[cand], s * self._e, self._e)
+        near = np.flatnonzero(d < self._dh)
+        act = near if cand is None else cand[near]
+        d, n, P = d[near], n[near], P[act] - s * self._e
         b, b1, b2 = log_barrier(d, self._dh)
         kw = self._kw[act]
         value = float((kw * b).sum()) - F * s

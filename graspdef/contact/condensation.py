@@ -24,18 +24,21 @@ class ForceControlledAdvance:
     def __init__(self, obstacle, e: np.ndarray, dhat: float, barrier, name: str, s: float = 0.0):
         self._obs, self._e, self._dh, self._barrier, self.name = obstacle, e, dhat, barrier, name
         self.s = s
+        self.window = None          # (centre, sample indices) of the last solve's final window
 
     def derivatives(self, pts, kw, s):
-        """(B_s, B_ss, feasible) at advance s for flat sample points pts (k, 3), weights kw (k,)."""
+        """(B_s, B_ss, feasible, smallest gap (inf for none)) at advance s for flat sample points
+        pts (k, 3), weights kw (k,)."""
         d, _, ds, dss = self._obs.along(pts, s * self._e, self._e)
-        if np.any(d <= 0):
-            return np.inf, 0.0, False
+        dmin = float(d.min()) if d.size else np.inf
+        if dmin <= 0:
+            return np.inf, 0.0, False, dmin
         act = d < self._dh
         if not act.any():
-            return 0.0, 0.0, True
+            return 0.0, 0.0, True, dmin
         _, b1, b2 = self._barrier(d[act], self._dh)
         ds, dss, kw = ds[act], dss[act], kw[act]
-        return float((kw * b1 * ds).sum()), float((kw * (b2 * ds * ds + b1 * dss)).sum()), True
+        return float((kw * b1 * ds).sum()), float((kw * (b2 * ds * ds + b1 * dss)).sum()), True, dmin
 
     def solve(self, P: np.ndarray, KW: np.ndarray, F: float) -> float:
         """The advance s* [m] where the barrier force along e of the sample points P (k, 3) with
@@ -43,19 +46,22 @@ class ForceControlledAdvance:
 
         Safeguarded Newton on dB/ds = F from the last solution, over the samples that can reach
         the barrier within a window |s - s_c| < W around a centre s_c (|d d/d s| <= 1, so the
-        others are inactive and feasible there); the window moves when an iterate leaves it."""
-        W = 8 * self._dh
+        others are inactive and feasible there); the window moves when an iterate leaves it.  The
+        final window is kept (:attr:`window`: its centre and sample indices; the samples outside
+        it are out of the barrier's reach at the solution)."""
+        W = self.reach
         sel = {}
 
         def window(sc):
             d = self._obs.along(P, sc * self._e, self._e)[0]
             idx = np.flatnonzero(d < self._dh + W)
-            sel.update(c=sc, p=P[idx], kw=KW[idx])
+            sel.update(c=sc, idx=idx, p=P[idx], kw=KW[idx], at=None)
 
         def G(t):
             if abs(t - sel["c"]) >= W:
                 window(t)
-            g, gs, ok = self.derivatives(sel["p"], sel["kw"], t)
+            g, gs, ok, dm = self.derivatives(sel["p"], sel["kw"], t)
+            sel["at"] = (t, dm)                  # the window's smallest gap at t (for dmin)
             return (g - F if ok else np.inf), gs, ok
 
         def dmin(t):
@@ -66,7 +72,10 @@ class ForceControlledAdvance:
             if off < W:
                 bound = self._dh + W - off
                 if len(sel["p"]):
-                    bound = min(bound, float(self._obs.along(sel["p"], t * self._e, self._e)[0].min()))
+                    at = sel["at"]
+                    gap = at[1] if at is not None and at[0] == t else \
+                        float(self._obs.along(sel["p"], t * self._e, self._e)[0].min())
+                    bound = min(bound, gap)
                 return bound
             return float(self._obs.along(P, t * self._e, self._e)[0].min())
 
@@ -118,7 +127,22 @@ class ForceControlledAdvance:
                 if small:
                     break
         self.s = s
+        self.window = (sel["c"], sel["idx"]) if abs(s - sel["c"]) < W else None
         return s
+
+    @property
+    def reach(self) -> float:
+        """The half-width W [m] of a window of advances: 8 dhat."""
+        return 8 * self._dh
+
+    def active_candidates(self, s: float, window) -> np.ndarray | None:
+        """The indices of the samples that can be within the barrier's reach at advance s: those
+        of ``window`` (a :attr:`window` of the solve at these points) when s lies inside it, else
+        None (all).  A sample outside the window had d >= dhat + W at its centre s_c, and
+        |d d/ds| <= 1, so d > dhat at any |s - s_c| < W."""
+        if window is None or not abs(s - window[0]) < self.reach:
+            return None
+        return window[1]
 
 
 def condensed_rank_one(Bss: float, v: np.ndarray) -> list:

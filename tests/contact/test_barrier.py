@@ -121,6 +121,23 @@ def test_contact_potential_derivatives(shell, obstacle):
     assert_fd_rate(q, fdl[0], fdl[1], scale=np.abs(q).max(), what="load")
 
 
+@pytest.mark.parametrize("obstacle", [_pin(), _pad()], ids=["pin", "pad"])
+def test_the_advance_window_leaves_out_only_inactive_samples(shell, obstacle):
+    """The contact terms summed over the samples of the finger advance's final window equal those
+    summed over all samples, to the bit: a sample outside the window had a gap >= dhat + W at its
+    centre and |d gap / d s| <= 1, so it is beyond the barrier's reach at the solution (the
+    window, not all samples, is what every evaluation after an advance measures)."""
+    fc = FingerContact(obstacle, (-1.0, 0, 0), 4.0, offset=T / 2).build(shell, shell.evaluator)
+    x = shell.rest_positions + np.random.default_rng(1).normal(size=shell.rest_positions.shape) * 2e-5
+    s, value, grad, H, Bss, v = fc._terms(x, 2.8, 3)
+    window = fc._cond.window
+    assert window is not None and 0 < window[1].size < fc._kw.size          # it does leave samples out
+    s_all, value_all, grad_all, H_all, Bss_all, v_all = fc._terms(x, 2.8, 3, s_at=s)   # every sample
+    assert (s_all, value_all, Bss_all) == (s, value, Bss)
+    assert np.array_equal(grad_all, grad) and np.array_equal(v_all, v)
+    assert (H_all != H).nnz == 0 and np.array_equal(H_all.indices, H.indices)
+
+
 def _squeeze(shell, contacts, loads, max_load=1.0, targets=()):
     pr = Problem(shell, list(contacts) + list(loads), [RigidModes()])
     return solve_nonlinear(pr, PathOptions(steps=4, max_load=max_load, targets=targets))
