@@ -17,6 +17,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -396,3 +397,28 @@ def test_the_memory_check_allows_for_the_factor_on_disk():
     with pytest.raises(ProblemError, match="out of core") as exc:                  # too large either way
         check_memory(200_000, "a mesh", available=have, out_of_core=True)
     assert "pardiso-ooc" not in str(exc.value)
+
+
+def test_a_killed_solves_factor_folder_is_removed_by_the_next_one(tmp_path):
+    """A process killed during an out-of-core solve leaves its factor files (its KKTSystem never
+    closes): the next out-of-core folder removes the folders of processes that no longer run once
+    they are an hour old, and keeps recent ones, those of running processes and any other folder."""
+    from graspdef.solve.sparse import OOC_PREFIX, OOC_STALE_S, ooc_folder
+
+    p = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True,
+                       check=True)
+    dead = tmp_path / f"{OOC_PREFIX}{int(p.stdout)}_abc"                  # that process has ended
+    (dead / "sub").mkdir(parents=True)
+    (dead / "mkl_pardiso_lnz.bin").write_bytes(b"\0" * 1000)
+    recent = tmp_path / f"{OOC_PREFIX}{int(p.stdout)}_ghi"               # the same, touched just now
+    recent.mkdir()
+    alive = tmp_path / f"{OOC_PREFIX}{os.getpid()}_def"
+    alive.mkdir()
+    other = tmp_path / f"{OOC_PREFIX}notapid"
+    other.mkdir()
+    old = time.time() - OOC_STALE_S - 60
+    for f in (dead, dead / "mkl_pardiso_lnz.bin", alive, other):
+        os.utime(f, (old, old))
+    new = ooc_folder(str(tmp_path))
+    assert not dead.exists() and recent.exists() and alive.exists() and other.exists()
+    assert os.path.basename(new).startswith(f"{OOC_PREFIX}{os.getpid()}_") and os.path.isdir(new)
