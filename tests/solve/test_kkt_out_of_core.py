@@ -30,8 +30,10 @@ needs_pardiso = pytest.mark.skipif(not pardiso_available(), reason="PARDISO (pyp
 #: ``graspdef solve --backend pardiso-ooc`` end to end: 9 of the 10 failures of this file in about
 #: 1,050 runs of it in two loops side by side (2026-11-26 to 27; the tenth's test was not recorded)
 #: came in these two tests -- a wrong factor caught by its check, a path refused at its first step, a
-#: Python object overwritten, a wrong "completed" answer; not in `make test` until the cause is
-#: found (README, "Out of core"); `make test-ooc` runs them
+#: Python object overwritten, a wrong "completed" answer; then (2026-11-27, ninth session, MKL on its
+#: sequential layer, one handle) 4 failures in 2,941 out-of-core processes, these tests' and standalone
+#: ones: memory corruption in MKL's out-of-core mode, cause not found; not in `make test` until it is
+#: (README, "Out of core"); `make test-ooc` runs them
 OOC_CLI = pytest.mark.ooc_cli
 
 PRELUDE = """
