@@ -507,7 +507,11 @@ def require_sequential_mkl(lib) -> None:
     suspect, not shown): the 12 x 12 plate's factor, every time the same way (a residual of
     4.96e-2, caught by the solve's check), in about 1 of 60 runs of
     tests/solve/test_kkt_out_of_core.py in two loops side by side -- even with one handle per
-    process -- and in none of 295 runs on the sequential layer (README, "Out of core").  In-core
+    process -- and in none of 295 runs on the sequential layer.  Later (2026-11-27, ninth session)
+    wrong factors came on the sequential layer too, of other values, with Python objects overwritten
+    in the same kind of process: 4 failures in 2,941 out-of-core processes (README, "Out of core"),
+    so this layer is not the cure of that fault; it stays because the threaded failures came more
+    often (3 in ~205 runs of the file, each several out-of-core processes).  In-core
     PARDISO keeps the threaded layer, so one process cannot hold both: an out-of-core solve needs a
     process that has not called MKL before (as ``graspdef solve --backend pardiso-ooc`` is)."""
     layer = int(lib.MKL_Set_Threading_Layer(ctypes.c_int(MKL_THREADING_SEQUENTIAL)))
