@@ -109,6 +109,16 @@ class Shell:
         return BlockPattern(self)
 
     @property
+    def has_block_pattern(self) -> bool:
+        """Whether :attr:`block_pattern` has been built (and is held)."""
+        return "block_pattern" in self.__dict__
+
+    def release_block_pattern(self) -> None:
+        """Drop the held :attr:`block_pattern` (built again on next use): a caller that needed one
+        Hessian (a linear solve) gives its element maps back -- at 100k control vertices 0.3 GB."""
+        self.__dict__.pop("block_pattern", None)
+
+    @property
     def n_dofs(self) -> int:
         return 3 * self.mesh.n_control
 

@@ -59,11 +59,11 @@ class LinearResponse:
     ``u_f`` (n_control, 3): the response to the loads at scale 1; ``u_g``: to the prescribed
     displacements."""
 
-    def __init__(self, problem: Problem, backend: str = "auto"):
+    def __init__(self, problem: Problem, backend: str = "auto", precision: str = "auto"):
         K = rest_stiffness(problem)
         f = problem.load_vector()
         C, _, g = problem.constraints(with_targets=True)
-        self.kkt = KKTSystem(C, backend)
+        self.kkt = KKTSystem(C, backend, precision)
         self.kkt.factor(K)
         uf, _, _ = self.kkt.solve(f)
         self.u_f = uf.reshape(-1, 3)
@@ -77,15 +77,26 @@ class LinearResponse:
         self.kkt.close()
 
 
-def solve_linear(problem: Problem, backend: str = "auto") -> LinearSolution:
-    """Assemble K0 (Hessian at rest), the load vector and the support constraints, and solve."""
+def solve_linear(problem: Problem, backend: str = "auto", precision: str = "auto") -> LinearSolution:
+    """Assemble K0 (Hessian at rest), the load vector and the support constraints, and solve.
+    ``precision`` "mixed": a single-precision factor refined in double to a double solve's
+    backward error, refactored in double if it does not get there
+    (:class:`graspdef.solve.sparse.KKTSystem`); "double": a double factor; "auto" (default): mixed
+    from 20,000 unknowns on (:data:`graspdef.solve.sparse.MIXED_MIN_UNKNOWNS`)."""
     t0 = time.perf_counter()
+    shell = problem.shell
+    built = shell.has_block_pattern
     K = rest_stiffness(problem)
+    if not built:
+        # one Hessian only: the pattern's element maps (built for it, 2.3 x K's index array) are not
+        # needed again, and at 100k they are 0.3 GB of the process's peak beside the factor (K keeps
+        # the pattern's index arrays it shares)
+        shell.release_block_pattern()
     t1 = time.perf_counter()
     f = problem.load_vector()
     C, _, g = problem.constraints(with_targets=True)
     t2 = time.perf_counter()
-    kkt = solve_kkt(K, C, f, backend=backend, g=g)
+    kkt = solve_kkt(K, C, f, backend=backend, g=g, precision=precision)
     timings = {"assembly": t1 - t0, "loads_constraints": t2 - t1, "factor": kkt.seconds_factor,
                "solve": kkt.seconds_solve}
     return LinearSolution(problem, kkt.u.reshape(-1, 3), kkt, timings, f)

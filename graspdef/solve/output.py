@@ -85,7 +85,8 @@ def result_record(spec: ProblemSpec, sol: LinearSolution | NonlinearSolution) ->
     derived["net_load_force"] = D.entry(force, units["force"], "net applied force", "sum of the applied loads")
     data.update({"net_load": {"force": force.tolist(), "moment_about_origin": moment.tolist()},
                  "n_constraints": int(len(sol.kkt.multipliers)),
-                 "solver": {"backend": sol.kkt.backend, "relative_residual": sol.kkt.residual,
+                 "solver": {"backend": sol.kkt.backend, "precision": sol.kkt.precision,
+                            "relative_residual": sol.kkt.residual,
                             "negative_pivots": sol.kkt.n_negative}})
     return RunRecord("solve", spec.name, "linear", units, derived, {}, data)
 

@@ -46,6 +46,7 @@ class KKTResult:
     u : (n,) displacements;  multipliers : (m,) constraint forces (Lagrange multipliers)
     backend : "pardiso", "pardiso-ooc" or "superlu";  n_negative : negative pivots (PARDISO) or None
     seconds_factor, seconds_solve : wall times;  residual : ||K u + C^T l - f|| / ||f||
+    precision : "mixed" (a single-precision factor, refined in double) or "double"
     """
 
     u: np.ndarray
@@ -55,6 +56,7 @@ class KKTResult:
     seconds_factor: float
     seconds_solve: float
     residual: float
+    precision: str = "double"
 
 
 def pardiso_available() -> bool:
@@ -115,9 +117,17 @@ class _UpperMap:
         Ct = C.T.tocsr()
         Ct.sort_indices()
         self.shape = (n + m, n + m)
-        self.U_indptr, self.U_indices, self.src = kkt_upper_pattern(
+        indptr, indices, self.src = kkt_upper_pattern(
             K.indptr.astype(np.int64, copy=False), K.indices.astype(np.int64, copy=False),
             Ct.indptr.astype(np.int64, copy=False), Ct.indices.astype(np.int64, copy=False), n, m)
+        if indices.size >= 2**31:
+            raise SolverError(f"the KKT matrix has {indices.size:,} non-zeros in its upper triangle: beyond "
+                              "PARDISO's 32-bit interface (2^31)")
+        if not np.diff(indptr).all():
+            raise SolverError("the KKT matrix has an empty row: the stiffness is singular (a degree of "
+                              "freedom without stiffness)")
+        # 32-bit and zero-based, as PARDISO reads them (iparm 35 = 1): passed without a copy per call
+        self.U_indptr, self.U_indices = indptr.astype(np.int32), indices.astype(np.int32)
         self.ct_data = np.asarray(Ct.data, float)
 
     def matches(self, K: sp.csr_matrix) -> bool:
@@ -125,11 +135,13 @@ class _UpperMap:
             K.nnz == self.indices.size and np.array_equal(K.indptr, self.indptr)
             and np.array_equal(K.indices, self.indices))
 
-    def upper(self, K: sp.csr_matrix, scale: float) -> sp.csr_matrix:
+    def upper(self, K: sp.csr_matrix, scale: float, dtype=np.float64) -> sp.csr_matrix:
         from graspdef.solve._kernels import kkt_upper_values
 
         data = kkt_upper_values(self.src, np.asarray(K.data, float), self.ct_data, float(scale))
-        return sp.csr_matrix((data, self.U_indices, self.U_indptr), shape=self.shape)
+        if dtype != np.float64:
+            data = data.astype(dtype)
+        return sp.csr_matrix((data, self.U_indices, self.U_indptr), shape=self.shape, copy=False)
 
 
 def kkt_upper(K: sp.spmatrix, C: sp.spmatrix, scale: float) -> sp.csr_matrix:
@@ -147,17 +159,32 @@ class KKTSystem:
     unperturbed system checked.  ``n_negative`` is the number of negative pivots of the last
     factorisation (PARDISO) -- the inertia that decides stability -- or None (SuperLU).
     Use as a context manager or call :meth:`close` to free PARDISO's memory.
+
+    ``precision`` "mixed" (in-core PARDISO only; see :data:`PRECISIONS`; "auto": mixed from
+    :data:`MIXED_MIN_UNKNOWNS` unknowns on): the factor is computed in
+    single precision -- half the memory and ~0.55 x the time of the double one -- and every solve
+    is refined with residuals in double until its backward error is at most
+    :data:`MIXED_BACKWARD_TOL`; when a check fails (a solve that does not refine to it, or an
+    inertia other than the expected one) the system refactors in double and goes on as "double".
+    ``single`` says whether the last factor is a single-precision one.
     """
 
-    def __init__(self, C: sp.spmatrix, backend: str = "auto"):
+    def __init__(self, C: sp.spmatrix, backend: str = "auto", precision: str = "double"):
         if backend not in BACKENDS:
             raise SolverError(f"unknown linear solver backend '{backend}' (valid: {', '.join(BACKENDS)})")
+        if precision not in PRECISIONS:
+            raise SolverError(f"unknown factorisation precision '{precision}' (valid: {', '.join(PRECISIONS)})")
         if backend == "auto":
             backend = "pardiso" if pardiso_available() else "superlu"
         if backend == "pardiso-ooc" and not pardiso_available():
             raise SolverError("backend 'pardiso-ooc' needs PARDISO (pypardiso with MKL), which is not available here")
         self.backend = backend
         self._pardiso = backend in ("pardiso", "pardiso-ooc")
+        # mixed: PARDISO factorises in single precision (in core only), every solve is refined in
+        # double until its backward error is a double solve's; a failed check refactors in double
+        # ("auto": mixed from MIXED_MIN_UNKNOWNS unknowns on, decided at the first factorisation)
+        self.precision = precision
+        self.single = precision in ("mixed", "auto") and backend == "pardiso"
         self._ooc_dir: str | None = None  # pardiso-ooc: the folder of PARDISO's factor files
         self.ooc_core_mb = OOC_CORE_MB    # pardiso-ooc: the factor's part held in memory [MB]
         self.C = C.tocsr()
@@ -224,6 +251,8 @@ class KKTSystem:
         self.n = self.K.shape[0]
         self.scale = constraint_scale(self.K)
         self.norm = kkt_norm(self.K, self.C, self.scale)
+        if self.precision == "auto" and self.n_factor == 0:
+            self.single = self.single and self.n + self.m >= MIXED_MIN_UNKNOWNS
         if self._pardiso:
             self._factor_pardiso(analyse)
         else:
@@ -242,14 +271,16 @@ class KKTSystem:
             K = K.sorted_indices()
         new_pattern = self._map is None or not self._map.matches(K)
         upper_map = _UpperMap(K, self.C) if new_pattern else self._map
-        U = upper_map.upper(K, self.scale)
+        # single precision (iparm 28 = 1): PARDISO reads the values and right-hand sides as float32
+        dtype = np.float32 if self.single else np.float64
+        U = upper_map.upper(K, self.scale, dtype)
         if self.backend == "pardiso-ooc" and self._solver is not None and new_pattern:
             # out of core, one PARDISO handle and one analysis per process (require_one_ooc_handle):
             # a pattern inside the analysed one is factorised on it (its missing entries zero),
             # any other is refused
             K, upper_map = self._on_analysed_pattern(K), self._map
             new_pattern = False
-            U = upper_map.upper(K, self.scale)
+            U = upper_map.upper(K, self.scale, dtype)
         if self._solver is None:
             solver = _new_pardiso(-2)
             if self.backend == "pardiso-ooc":
@@ -259,22 +290,20 @@ class KKTSystem:
             ooc = {60: 2} if self.backend == "pardiso-ooc" else {}
             if ooc and self._ooc_dir is None:
                 self._ooc_dir = ooc_folder()
-            for k, v in {**_PARDISO_IPARM, **self._variant_iparm(), **ooc}.items():
+            for k, v in {**_PARDISO_IPARM, **self._variant_iparm(), **ooc, 28: int(self.single)}.items():
                 self._solver.set_iparm(k, v)
         s = self._solver
-        s._check_A(U)
-        z = np.zeros((U.shape[0], 1))
+        self._U = U
+        z = np.zeros((U.shape[0], 1), dtype)
         try:
             if analyse or new_pattern:
                 with self._ooc_environment():
-                    s.set_phase(11)                     # analysis (matching, ordering)
-                    s._call_pardiso(U, z)
+                    self._call(11, z)                   # analysis (matching, ordering)
                 self._map = upper_map                   # kept once PARDISO has analysed it
                 if self._ooc_dir is not None:
                     self._fit_ooc_core(int(s.get_iparm(61)))
             with self._ooc_environment():
-                s.set_phase(22)                         # numerical factorisation
-                s._call_pardiso(U, z)
+                self._call(22, z)                       # numerical factorisation
         except Exception as exc:
             if self._ooc_dir is None or getattr(exc, "value", None) != -9:
                 raise
@@ -285,7 +314,6 @@ class KKTSystem:
                               "matrix's factorisation (error -9) although its analysis asked for no more; "
                               "raise graspdef.solve.sparse.OOC_CORE_MB and run again") from None
         self.n_factor += 1
-        self._U = U
         self.perturbed = int(s.get_iparm(14))
         self.n_negative = int(s.get_iparm(23))
 
@@ -334,10 +362,13 @@ class KKTSystem:
         return dict(_PARDISO_FALLBACKS[self.variant - 1]) if self.variant else {}
 
     def negative_pivots(self, expected: int) -> int | None:
-        """The last factorisation's number of negative pivots; when it is not ``expected`` and the
-        default settings are in use, after one refactorisation with the first fallback settings
+        """The last factorisation's number of negative pivots; when it is not ``expected``, after a
+        refactorisation in double precision if the factor was a single one, and when the default
+        settings are in use, after one refactorisation with the first fallback settings
         (:meth:`retry_robust`; an unstable state is so confirmed once per system, not at every
         unstable point of a path).  None: no inertia (SuperLU)."""
+        if self.n_negative is not None and self.n_negative != expected and self.single:
+            self.retry_robust()                         # a single factor's inertia is confirmed in double first
         if self.n_negative is not None and self.n_negative != expected and not self.robust and self.retry_robust():
             log.info("KKT: %d negative pivots for %d expected with the robust settings", self.n_negative, expected)
         return self.n_negative
@@ -353,6 +384,16 @@ class KKTSystem:
         1e-2 that the defaults solve to 3e-12."""
         if not self._pardiso or self._solver is None:
             return False
+        if self.single:
+            # a single-precision factor failed a check: the same settings in double precision first
+            t0 = time.perf_counter()
+            log.info("KKT: refactoring in double precision after the single-precision factor failed a check")
+            self.single = False
+            self._solver.free_memory(everything=True)
+            self._solver = None
+            self._factor_pardiso(True)
+            self.seconds_factor += time.perf_counter() - t0
+            return True
         if self.backend == "pardiso-ooc":
             # another variant needs a fresh handle, which out of core is not allowed
             # (require_one_ooc_handle): the check's failure stands
@@ -385,10 +426,35 @@ class KKTSystem:
     def _back(self, b: np.ndarray) -> np.ndarray:
         self.n_back += 1 if b.ndim == 1 else b.shape[1]
         if self._pardiso:
-            self._solver.set_phase(33)
             with self._ooc_environment():
-                return self._solver._call_pardiso(self._U, np.asfortranarray(b)).reshape(b.shape)
+                x = self._call(33, np.asfortranarray(b, self._U.dtype))
+            return np.ascontiguousarray(x, float).reshape(b.shape)
         return self._lu.solve(b)
+
+    def _call(self, phase: int, b: np.ndarray) -> np.ndarray:
+        """One call of MKL's ``pardiso`` on the last KKT upper triangle (``self._U``: zero-based
+        32-bit indices, iparm 35 = 1; float32 values when iparm 28 = 1) with right-hand sides ``b``
+        (Fortran order, U's dtype); returns x.  pypardiso's own call copies the index arrays to
+        one-based ones at every call (at 100k: 2 x 68 MB and ~50 ms per back-substitution) and
+        accepts float64 only; this one passes them as they are.  Raises pypardiso's
+        PyPardisoError (``value``: PARDISO's error code)."""
+        from pypardiso.pardiso_wrapper import PyPardisoError
+
+        s, U = self._solver, self._U
+        x = np.zeros_like(b)
+        err = ctypes.c_int32(0)
+        i32p, f64p = ctypes.POINTER(ctypes.c_int32), ctypes.POINTER(ctypes.c_double)
+        s._mkl_pardiso(s.pt.ctypes.data_as(ctypes.POINTER(s._pt_type[0])),
+                       ctypes.byref(ctypes.c_int32(1)), ctypes.byref(ctypes.c_int32(1)),      # maxfct, mnum
+                       ctypes.byref(ctypes.c_int32(s.mtype)), ctypes.byref(ctypes.c_int32(phase)),
+                       ctypes.byref(ctypes.c_int32(U.shape[0])),
+                       U.data.ctypes.data_as(f64p), U.indptr.ctypes.data_as(i32p), U.indices.ctypes.data_as(i32p),
+                       s.perm.ctypes.data_as(i32p), ctypes.byref(ctypes.c_int32(1 if b.ndim == 1 else b.shape[1])),
+                       s.iparm.ctypes.data_as(i32p), ctypes.byref(ctypes.c_int32(int(s.msglvl))),
+                       b.ctypes.data_as(f64p), x.ctypes.data_as(f64p), ctypes.byref(err))
+        if err.value != 0:
+            raise PyPardisoError(err.value)
+        return x
 
     def solve(self, f: np.ndarray, g: np.ndarray | None = None, rtol: float = 1e-8,
               refinements: int = 3) -> tuple[np.ndarray, np.ndarray, float]:
@@ -421,22 +487,28 @@ class KKTSystem:
         sol = self._back(rhs)
         res = residual(sol)
         eta = backward_error(self.norm, sol, res, rhs)
-        for _ in range(refinements):
-            if (not np.all(np.isfinite(sol)) or np.linalg.norm(res) <= 0.01 * rtol * bn
-                    or eta <= 0.01 * BACKWARD_TOL):
+        single = self.single
+        for _ in range(MIXED_REFINEMENTS if single else refinements):
+            if not np.all(np.isfinite(sol)) or eta <= (MIXED_FLOOR if single else 0.01 * BACKWARD_TOL):
+                break
+            if not single and np.linalg.norm(res) <= 0.01 * rtol * bn:
                 break
             new = sol - self._back(res)
             new_res = residual(new)
             new_eta = backward_error(self.norm, new, new_res, rhs)
             if not new_eta < eta:                       # refinement at its round-off limit
                 break
+            slow = new_eta > 0.5 * eta
             sol, res, eta = new, new_res, new_eta
+            if single and slow:                         # a single factor's refinement at its limit
+                break
         self.seconds_solve += time.perf_counter() - t0
         finite = bool(np.all(np.isfinite(sol)))
         if finite:
             rel = float(np.linalg.norm(res) / bn)
             amp = self.norm * float(np.abs(sol).max()) / max(float(np.abs(rhs).max()), 1e-300)
-        if (not finite or rel > rtol and not (eta <= BACKWARD_TOL and amp <= MAX_AMPLIFICATION)) and self.retry_robust():
+        failed = not finite or rel > rtol and not (eta <= BACKWARD_TOL and amp <= MAX_AMPLIFICATION)
+        if (failed or single and eta > MIXED_BACKWARD_TOL) and self.retry_robust():
             return self.solve(f, g_in, rtol=rtol, refinements=refinements)
         if not finite:
             raise SolverError("the linear solve produced non-finite values (singular system)")
@@ -452,6 +524,36 @@ class KKTSystem:
 #: system leaves (PARDISO perturbs tiny pivots by 1e-8 of the matrix norm).
 BACKWARD_TOL = 1e-12
 
+#: Factorisation precisions of :class:`KKTSystem`: "double", or "mixed" -- a single-precision
+#: PARDISO factor whose solves are refined with double residuals (Wilkinson's iterative refinement;
+#: Higham, *Accuracy and Stability of Numerical Algorithms*, ch. 12; Langou et al. 2006), in core only.
+#: Measured on the pinched cylinder (README, "Mixed precision"): the factor's memory and time about
+#: halved, 2-6 refinement steps.
+PRECISIONS = ("auto", "double", "mixed")
+
+#: "auto" precision: mixed from this many unknowns (displacements and constraints) on, double below.
+#: The factor's time and memory matter from about the 10k pinched cylinder's 31,693 on; below, a
+#: double factor takes milliseconds and its answers stay the same to the bit as before mixed
+#: precision existed (and the 288-cell cylinder, whose nearly dependent support rows make its
+#: single factor's inertia wrong, 188 for 185, does not pay for a single factor it then replaces)
+MIXED_MIN_UNKNOWNS = 20_000
+
+#: Largest backward error of an accepted mixed-precision solve (:class:`KKTSystem`): above it the
+#: single factor is replaced by a double one.  The refinement goes on below it, to
+#: :data:`MIXED_FLOOR` or until a step no longer halves the backward error, so that the answer is a
+#: double solve's to round-off times the condition number: on the 1/8 soda can (t/R = 0.003) a
+#: double factor's solve has 2.6e-17, the mixed one's steps 2.1e-8, 9.8e-11, 1.2e-12, 7.5e-15, ...
+MIXED_BACKWARD_TOL = 1e-14
+
+#: Backward error at which a mixed-precision solve's refinement stops (about the double rounding
+#: of a residual)
+MIXED_FLOOR = 1e-16
+
+#: Most refinement steps of a mixed-precision solve: a single factor that has not refined a solve to
+#: MIXED_BACKWARD_TOL after them (a contraction slower than ~8 per step, i.e. a condition number
+#: approaching 1 / single precision's 6e-8) is replaced by a double one
+MIXED_REFINEMENTS = 12
+
 #: Largest |A| |x| / |b| (infinity norms) of a solve accepted by its backward error: beyond it
 #: (a condition number above 1e12, ~1e-4 / eps) the system is taken as singular.  The slit ring's
 #: tangent solves have 9e8.
@@ -460,11 +562,22 @@ MAX_AMPLIFICATION = 1e12
 
 def kkt_norm(K: sp.csr_matrix, C: sp.spmatrix, scale: float) -> float:
     """Infinity norm (largest absolute row sum) of the KKT matrix [[K, s C^T], [s C, 0]]."""
-    rows = np.asarray(abs(K).sum(axis=1)).ravel()
+    rows = _abs_row_sums(K)
     if C.shape[0]:
         rows = rows + scale * np.asarray(abs(C).sum(axis=0)).ravel()
         rows = np.concatenate([rows, scale * np.asarray(abs(C).sum(axis=1)).ravel()])
     return float(rows.max()) if rows.size else 0.0
+
+
+def _abs_row_sums(A: sp.spmatrix) -> np.ndarray:
+    """sum_j |A_ij| per row, without the copy of the whole matrix that ``abs(A)`` makes (the 100k
+    cylinder's K: 0.4 GB and 0.75 s per factorisation)."""
+    A = A.tocsr()
+    out = np.zeros(A.shape[0])
+    nz = np.flatnonzero(np.diff(A.indptr))
+    if nz.size:
+        out[nz] = np.add.reduceat(np.abs(A.data), A.indptr[nz])
+    return out
 
 
 def backward_error(norm: float, x: np.ndarray, r: np.ndarray, b: np.ndarray) -> float:
@@ -631,6 +744,7 @@ _PARDISO_IPARM = {
     11: 1,      # symmetric scaling
     13: 2,      # weighted matching, improved variant (saddle-point systems)
     21: 1,      # Bunch-Kaufman pivoting
+    35: 1,      # zero-based indices (KKTSystem._call passes scipy's own)
 }
 
 #: PARDISO settings of a second factorisation when the first fails a check (a solve's residual and
@@ -654,10 +768,11 @@ _PARDISO_FALLBACKS = (_PARDISO_ROBUST, {2: 0})
 
 
 def solve_kkt(K: sp.spmatrix, C: sp.spmatrix, f: np.ndarray, backend: str = "auto",
-              rtol: float = 1e-8, refinements: int = 3, g: np.ndarray | None = None) -> KKTResult:
+              rtol: float = 1e-8, refinements: int = 3, g: np.ndarray | None = None,
+              precision: str = "double") -> KKTResult:
     """Solve K u + C^T l = f, C u = g (default g = 0); raise SupportError/SolverError on singular
-    or unbalanced systems."""
-    with KKTSystem(C, backend) as kkt:
+    or unbalanced systems.  ``precision``: see :class:`KKTSystem`."""
+    with KKTSystem(C, backend, precision) as kkt:
         kkt.factor(K)
         m = kkt.m
         neg = kkt.negative_pivots(m)
@@ -667,6 +782,8 @@ def solve_kkt(K: sp.spmatrix, C: sp.spmatrix, f: np.ndarray, backend: str = "aut
                 f"negative pivots for {m} constraints (expected {m}; {kkt.perturbed} pivots perturbed). A "
                 "mechanism is free (a part without supports, or redundant/conflicting supports).")
         u, lam, rel = kkt.solve(f, g, rtol=rtol, refinements=refinements)
-    log.info("KKT %s: n=%d m=%d factor %.3fs solve %.3fs residual %.1e", kkt.backend, len(f), m,
+    log.info("KKT %s (%s): n=%d m=%d factor %.3fs solve %.3fs residual %.1e", kkt.backend,
+             "mixed" if kkt.single else "double", len(f), m,
              kkt.seconds_factor, kkt.seconds_solve, rel)
-    return KKTResult(u, lam, kkt.backend, kkt.n_negative, kkt.seconds_factor, kkt.seconds_solve, rel)
+    return KKTResult(u, lam, kkt.backend, kkt.n_negative, kkt.seconds_factor, kkt.seconds_solve, rel,
+                     "mixed" if kkt.single else "double")
