@@ -30,7 +30,7 @@ from .edges import face_centroids
 from .loads import BodyForce, EdgeLoad, PointLoad, Pressure
 from .potentials import EdgeMoment, EnclosedGas, FollowerPressure
 from .nitsche import NITSCHE_GAMMA
-from .problem import BACKENDS, Problem, SurfacePoint, locate
+from .problem import BACKENDS, PRECISIONS, Problem, SurfacePoint, locate
 from .supports import KINDS, EdgeSupport, PointSupport, RigidModes
 
 _TOP = {"name", "description", "units", "geometry", "material", "shell", "regions", "supports",
@@ -52,7 +52,7 @@ _GEOMETRY = {
 _GEOMETRY_OPTIONAL = {"center", "theta0_deg", "theta1_deg", "hole_angle_deg", "scale", "units", "slit_deg", "holes", "refinements"}
 _INTEGER_KEYS = {"nx", "ny", "n", "n_theta", "n_z", "n_rings", "subdivisions", "n_r", "refinements"}
 #: [solver] keys and their kinds ("length" values are converted from the file's length unit)
-_SOLVER = {"backend": "str", "collocation": "int", "nitsche_gamma": "float", "type": "str", "method": "str", "steps": "int",
+_SOLVER = {"backend": "str", "precision": "str", "collocation": "int", "nitsche_gamma": "float", "type": "str", "method": "str", "steps": "int",
            "max_load": "float", "targets": "list", "max_steps": "int", "max_iterations": "int", "tol": "float",
            "min_step": "float", "desired_iterations": "int", "max_growth": "float", "max_step": "float",
            "line_search": "bool",
@@ -258,7 +258,11 @@ def _solver(solver: Table, units: FileUnits) -> tuple[str, int, float, dict]:
         else:
             opts[k] = solver.number(k)
     solver.string("type", "linear", choices=("linear", "nonlinear"))
-    path_keys = set(opts) - {"type", "backend", "collocation", "nitsche_gamma"}
+    solver.string("precision", "auto", choices=PRECISIONS)
+    if opts.get("type", "linear") == "nonlinear" and "precision" in opts:
+        raise solver.error("precision only applies to type = \"linear\": a path's tangents are factorised in "
+                           "double precision, because their inertia decides its stability")
+    path_keys = set(opts) - {"type", "backend", "precision", "collocation", "nitsche_gamma"}
     if opts.get("type", "linear") == "linear" and path_keys:
         raise solver.error(f"{', '.join(sorted(path_keys))} only apply to type = \"nonlinear\"")
     return backend, ncol, gamma, opts

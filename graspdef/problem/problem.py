@@ -21,6 +21,7 @@ from .supports import RigidModes, check_rigid_modes, constraint_rows, well_condi
 
 #: sparse solver back-ends a problem may ask for (graspdef.solve.sparse implements them)
 BACKENDS = ("auto", "pardiso", "pardiso-ooc", "superlu")     # pardiso-ooc: PARDISO out of core (graspdef.solve.sparse)
+PRECISIONS = ("auto", "double", "mixed")     # a linear solve's factor (graspdef.solve.sparse.KKTSystem)
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import SolverError, SupportError
-from ..problem.problem import BACKENDS
+from ..problem.problem import BACKENDS, PRECISIONS
 from ..runtime import environment, locate_mkl_rt
 
 log = logging.getLogger(__name__)
@@ -524,12 +524,11 @@ class KKTSystem:
 #: system leaves (PARDISO perturbs tiny pivots by 1e-8 of the matrix norm).
 BACKWARD_TOL = 1e-12
 
-#: Factorisation precisions of :class:`KKTSystem`: "double", or "mixed" -- a single-precision
-#: PARDISO factor whose solves are refined with double residuals (Wilkinson's iterative refinement;
-#: Higham, *Accuracy and Stability of Numerical Algorithms*, ch. 12; Langou et al. 2006), in core only.
-#: Measured on the pinched cylinder (README, "Mixed precision"): the factor's memory and time about
-#: halved, 2-6 refinement steps.
-PRECISIONS = ("auto", "double", "mixed")
+# Factorisation precisions of KKTSystem (PRECISIONS, defined with the problem's BACKENDS): "double",
+# or "mixed" -- a single-precision PARDISO factor whose solves are refined with double residuals
+# (Wilkinson's iterative refinement; Higham, *Accuracy and Stability of Numerical Algorithms*,
+# ch. 12; Langou et al. 2006), in core only.  Measured on the pinched cylinder (README, "Mixed
+# precision"): the factor's memory halved, its time ~0.6 x, 4-8 refinement steps.
 
 #: "auto" precision: mixed from this many unknowns (displacements and constraints) on, double below.
 #: The factor's time and memory matter from about the 10k pinched cylinder's 31,693 on; below, a

@@ -53,6 +53,11 @@ def test_values_with_their_own_units_are_the_same(tmp_path):
      r"default 20\) must be positive, got 0.0"),
     (('[[loads]]', '[solver]\nnitsche_gamma = "big"\n[[loads]]'), r"p.toml: \[solver\] nitsche_gamma must be a number"),
     (('[[loads]]', '[solver]\ntype = "nonlin"\n[[loads]]'), r"\[solver\] unknown type 'nonlin' \(did you mean 'nonlinear'\?\)"),
+    (('[[loads]]', '[solver]\nprecision = "single"\n[[loads]]'),
+     r"\[solver\] unknown precision 'single'"),
+    (('[[loads]]', '[solver]\ntype = "nonlinear"\nprecision = "mixed"\n[[loads]]'),
+     r"p.toml: \[solver\] precision only applies to type = \"linear\": a path's tangents are factorised in double "
+     r"precision, because their inertia decides its stability"),
     (('nx = 4', 'nx = 4.0'), r"\[geometry\] nx must be an integer, got 4.0"),
     (('[units]', '[units'), r"p.toml: line \d+, column \d+: not valid TOML"),
 ])
@@ -77,3 +82,21 @@ def test_nitsche_gamma_reaches_the_problem_and_applies_to_linear_files(tmp_path)
     assert _load(tmp_path, BASE).problem.nitsche_gamma == 20.0
     spec = _load(tmp_path, BASE.replace("[[loads]]", '[solver]\ntype = "linear"\nnitsche_gamma = 80.0\n[[loads]]', 1))
     assert spec.problem.nitsche_gamma == 80.0
+
+
+def test_precision_reaches_the_linear_solve_and_its_record(tmp_path):
+    """``[solver] precision`` (a linear file's) is what ``graspdef solve`` factorises with, and
+    result.json says which factor solved it; the two give the same centre deflection to 1e-9."""
+    import json
+
+    from graspdef.cli import main
+
+    out = {}
+    for precision in ("mixed", "double"):
+        f = tmp_path / f"{precision}.toml"
+        f.write_text(BASE.replace("[[loads]]", f'[solver]\nprecision = "{precision}"\n[[loads]]', 1))
+        assert main(["-q", "solve", str(f), "--out", str(tmp_path / precision)]) == 0
+        rec = json.loads((tmp_path / precision / "result.json").read_text())
+        assert rec["solver"]["precision"] == precision
+        out[precision] = rec["probes"]["centre"]["displacement"][2]
+    assert out["double"] != 0 and abs(out["mixed"] / out["double"] - 1) < 1e-9, out
