@@ -9,7 +9,9 @@ space of C.  Backends: MKL PARDISO through pypardiso (symmetric indefinite LDL^T
 default, see README for the measurements) and SciPy's SuperLU (fallback, no inertia).  Backend
 "pardiso-ooc" is PARDISO out of core: the factor is written to files in a temporary folder (removed
 when the system is closed) and only :data:`OOC_CORE_MB` of it is held in memory at a time -- for
-problems whose in-core factor does not fit (the 100k pinched cylinder's is 2.8 GB).
+problems whose in-core factor does not fit (the 100k pinched cylinder's is 2.8 GB in double, 1.1 GB
+in single precision).  ``precision`` "mixed" (:class:`KKTSystem`): a single-precision factor whose
+solves are refined in double to a double solve's backward error.
 No regularisation is accepted: PARDISO may perturb tiny pivots of the zero constraint block during
 the factorisation, but the solution is then refined iteratively and its residual in the
 *unperturbed* system is checked; a wrong inertia (a mechanism) is reported as an error.
