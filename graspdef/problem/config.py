@@ -136,7 +136,7 @@ def read_units(doc: Table) -> FileUnits:
     return FileUnits(lu, fu, u.unit("length", "length")[1], u.unit("force", "force")[1])
 
 
-def _geometry(g: Table, units: FileUnits, base: Path, out_of_core: bool = False):
+def _geometry(g: Table, units: FileUnits, base: Path, out_of_core: bool = False, linear: str | None = None):
     if "type" not in g:
         raise g.error("needs a 'type' (" + ", ".join(_GEOMETRY) + ")")
     kind = g.string("type", choices=_GEOMETRY)
@@ -174,7 +174,7 @@ def _geometry(g: Table, units: FileUnits, base: Path, out_of_core: bool = False)
             args[k] = g.number(k)
     n_est = _vertex_count(kind, args)
     if n_est is not None:                 # before the mesh is generated: a huge one would exhaust memory
-        check_memory(n_est, f"{g.where()}: this {kind}", out_of_core=out_of_core)
+        check_memory(n_est, f"{g.where()}: this {kind}", out_of_core=out_of_core, linear=linear)
     if kind == "monkey_saddle":   # x^3 - 3 x y^2 = scale z, scale in length^2 (one factor above)
         hw = args.pop("half_width")
         scale = args.pop("scale", 5000.0 * ls) * ls
@@ -280,8 +280,10 @@ def load_problem(path: str | Path, backend: str | None = None) -> ProblemSpec:
     # the [solver] table first: its backend decides the memory check before the mesh is built
     file_backend, ncol, gamma, opts = _solver(doc.table("solver", required=False), units)
     ooc = (backend or file_backend) == "pardiso-ooc"
+    # the memory check's kind of solve: a linear one's factor precision, or None for a path
+    linear = opts.get("precision", "auto") if opts.get("type", "linear") == "linear" else None
     geo = doc.table("geometry")
-    mesh = _geometry(geo, units, p.parent, ooc)
+    mesh = _geometry(geo, units, p.parent, ooc, linear)
     material = _material(doc.table("material"), units)
 
     sh = doc.table("shell").check({"thickness", "quadrature"}, ("thickness",))
@@ -292,7 +294,7 @@ def load_problem(path: str | Path, backend: str | None = None) -> ProblemSpec:
     if nq not in (3, 6, 12):
         raise sh.error(f"must be 3, 6 or 12 points per face, got {nq}", "quadrature")
     interp = geo.boolean("interpolate", None)
-    check_memory(mesh.n_vertices, f"{p}: the mesh", out_of_core=ooc)
+    check_memory(mesh.n_vertices, f"{p}: the mesh", out_of_core=ooc, linear=linear)
     shell = Shell(mesh.vertices, mesh.faces, material, thickness, n_quad=nq, interpolate=interp)
 
     regions = doc.table("regions", required=False)
