@@ -242,26 +242,14 @@ def _upper_csr(A):
 
 
 def project_pardiso_iparm() -> dict[int, int]:
-    """The iparm values (1-based index -> value) that ``graspdef.solve.sparse._factor_pardiso`` sets.
-
-    Read by running it on a 2x2 matrix with ``PyPardisoSolver.factorize`` stubbed out, so the
-    benchmark follows the production settings when they change."""
-    import inspect
-
-    import pypardiso
-    import scipy.sparse as sp
+    """The iparm values (1-based index -> value) of graspdef's KKT factorisations
+    (``graspdef.solve.sparse._PARDISO_IPARM``), so that the benchmark follows the production
+    settings when they change -- without iparm 35 (zero-based indices), which graspdef's own PARDISO
+    call uses and pypardiso's one-based call, used here, must not.  (Until 2026-11-27 this read them by
+    stubbing a module-level ``_factor_pardiso`` that had become a method: the function had stopped working.)"""
     from graspdef.solve import sparse as gs
 
-    seen = {}
-    original = pypardiso.PyPardisoSolver.factorize
-    pypardiso.PyPardisoSolver.factorize = lambda self, A: seen.update(iparm=self.iparm.copy())
-    try:
-        U = sp.csr_matrix(np.array([[1.0, 1.0], [0.0, 0.0]]))
-        n_args = len(inspect.signature(gs._factor_pardiso).parameters)
-        gs._factor_pardiso(*[U, 1][:n_args])
-    finally:
-        pypardiso.PyPardisoSolver.factorize = original
-    return {i + 1: int(v) for i, v in enumerate(seen["iparm"]) if v and i != 11}   # iparm(12): set per call
+    return {k: int(v) for k, v in gs._PARDISO_IPARM.items() if k != 35}
 
 
 def _pardiso(mtype: int):

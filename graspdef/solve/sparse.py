@@ -428,6 +428,15 @@ class KKTSystem:
     def _back(self, b: np.ndarray) -> np.ndarray:
         self.n_back += 1 if b.ndim == 1 else b.shape[1]
         if self._pardiso:
+            if self._U.dtype == np.float32:
+                # each column scaled to a largest entry of 1 in single precision: a residual's
+                # entries far below 1e-38 [SI] would otherwise be flushed to zero (and above 3e38 overflow)
+                b2 = b.reshape(b.shape[0], -1)
+                beta = np.abs(b2).max(axis=0)
+                beta[~(beta > 0) | ~np.isfinite(beta)] = 1.0
+                with self._ooc_environment():
+                    x = self._call(33, np.asfortranarray(b2 / beta, np.float32))
+                return (np.asarray(x, float) * beta).reshape(b.shape)
             with self._ooc_environment():
                 x = self._call(33, np.asfortranarray(b, self._U.dtype))
             return np.ascontiguousarray(x, float).reshape(b.shape)

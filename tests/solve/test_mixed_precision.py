@@ -167,3 +167,20 @@ def test_the_memory_check_knows_a_linear_solve_and_its_precision():
     with pytest.raises(ProblemError, match=r'precision = "mixed"') as exc:
         check_memory(n, "a mesh", available=have, linear="double")
     assert "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize("load", [1e-40, 1e30])
+def test_a_mixed_solve_of_tiny_or_huge_loads_is_the_scaled_answer(load):
+    """Linearity: loads of 1e-40 or 1e30 N (beyond float32's normal range, 1.2e-38 ... 3.4e38)
+    give load x the unit load's displacements to 1e-12 -- each right-hand side is scaled to unit
+    size before it meets the single-precision factor."""
+    pr = _cylinder()
+    K = rest_stiffness(pr)
+    f = pr.load_vector()
+    C = pr.constraints(with_targets=True)[0]
+    with S.KKTSystem(C, "pardiso", "mixed") as kkt:
+        kkt.factor(K)
+        u1 = kkt.solve(f)[0]
+        u = kkt.solve(load * f)[0]
+        assert kkt.single
+    assert np.abs(u / load - u1).max() <= 1e-12 * np.abs(u1).max()
