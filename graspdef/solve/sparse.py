@@ -164,10 +164,11 @@ class KKTSystem:
 
     ``precision`` "mixed" (in-core PARDISO only; see :data:`PRECISIONS`; "auto": mixed from
     :data:`MIXED_MIN_UNKNOWNS` unknowns on): the factor is computed in
-    single precision -- half the memory and ~0.55 x the time of the double one -- and every solve
-    is refined with residuals in double until its backward error is at most
-    :data:`MIXED_BACKWARD_TOL`; when a check fails (a solve that does not refine to it, or an
-    inertia other than the expected one) the system refactors in double and goes on as "double".
+    single precision -- half the memory and ~0.6 x the time of the double one -- and every solve
+    is refined with residuals in double down to :data:`MIXED_FLOOR` (or until a step no longer
+    halves its backward error) and accepted at :data:`MIXED_BACKWARD_TOL`; when a check fails (a
+    solve that does not refine to it, or an inertia other than the expected one) the system
+    refactors in double and goes on as "double".
     ``single`` says whether the last factor is a single-precision one.
     """
 
@@ -446,8 +447,8 @@ class KKTSystem:
         """One call of MKL's ``pardiso`` on the last KKT upper triangle (``self._U``: zero-based
         32-bit indices, iparm 35 = 1; float32 values when iparm 28 = 1) with right-hand sides ``b``
         (Fortran order, U's dtype); returns x.  pypardiso's own call copies the index arrays to
-        one-based ones at every call (at 100k: 2 x 68 MB and ~50 ms per back-substitution) and
-        accepts float64 only; this one passes them as they are.  Raises pypardiso's
+        one-based ones at every call (at 100k: 2 x 68 MB) and accepts float64 only; this one passes
+        them as they are.  Raises pypardiso's
         PyPardisoError (``value``: PARDISO's error code)."""
         from pypardiso.pardiso_wrapper import PyPardisoError
 
