@@ -69,7 +69,8 @@ def run(args: argparse.Namespace) -> int:
         from ..solve.linear import solve_linear
 
         sol = solve_linear(spec.problem, backend=backend, precision=spec.solver.get("precision", "auto"))
-        progress(args, "solved: " + ", ".join(f"{k} {v:.2f} s" for k, v in sol.timings.items()))
+        progress(args, "solved: " + ", ".join(f"{k} {v:.2f} s" for k, v in sol.timings.items())
+                 + ("; a single-precision factor, refined in double" if sol.kkt.precision == "mixed" else ""))
     out = write_run(args.out, spec, sol, Path(args.problem).read_text())
     rec = result_record(spec, sol)
     ls = spec.length_scale                 # the record is SI; the lines speak the problem file's unit
