@@ -107,6 +107,39 @@ def test_an_ill_conditioned_system_falls_back_to_a_double_factor():
     assert np.linalg.norm(u - exact) / np.linalg.norm(exact) < 1e10 * 1e-15
 
 
+def test_gmres_refinement_gets_there_where_plain_refinement_stalls():
+    """cond(K) = 1e9 (cond x single precision ~ 60): plain refinement with the single factor stalls
+    at a backward error ~1e-8; the correction solved by GMRES preconditioned by the same factor
+    (GMRES-IR, Carson & Higham 2017) reaches MIXED_BACKWARD_TOL without a double factor, and the
+    answer is the exact one to cond x eps."""
+    rng = np.random.default_rng(0)
+    n = 60
+    Q, _ = np.linalg.qr(rng.standard_normal((n, n)))
+    K = sp.csr_matrix((Q * np.logspace(0, -9, n)) @ Q.T)
+    C = sp.csr_matrix(np.ones((1, n)) / np.sqrt(n))
+    b = rng.standard_normal(n)
+    b -= C.toarray().ravel() * (C.toarray().ravel() @ b)
+    etas = []
+    with S.KKTSystem(C, "pardiso", "mixed") as kkt:
+        kkt.factor(K)
+        u, lam, _ = kkt.solve(b)
+        assert kkt.single and kkt.n_factor == 1          # no double factor was needed
+        res = K @ u + C.T @ lam - b
+        eta = np.abs(res).max() / (kkt.norm * np.abs(np.concatenate([u, lam / kkt.scale])).max() + np.abs(b).max())
+        assert eta <= S.MIXED_BACKWARD_TOL, eta
+        # plain refinement alone stalls: two steps leave it far above (the first solve's ~1e-8)
+        x = kkt._back(np.concatenate([b, [0.0]]))
+        A = np.block([[K.toarray(), kkt.scale * C.toarray().T], [kkt.scale * C.toarray(), np.zeros((1, 1))]])
+        rhs = np.concatenate([b, [0.0]])
+        for _ in range(2):
+            x = x - kkt._back(A @ x - rhs)
+        etas.append(S.backward_error(kkt.norm, x, A @ x - rhs, rhs))
+    assert etas[0] > 1e3 * S.MIXED_BACKWARD_TOL, etas
+    Z = np.linalg.svd(C.toarray())[2][1:].T
+    exact = Z @ np.linalg.solve(Z.T @ K.toarray() @ Z, Z.T @ b)
+    assert np.linalg.norm(u - exact) / np.linalg.norm(exact) < 1e9 * 1e-15
+
+
 def test_a_mechanism_is_still_refused_in_mixed_precision():
     """Without the point that holds the cylinder axially, a rigid axial slide is free: the mixed
     solve refuses it (SupportError) as the double one does -- a single factor's inertia is not
