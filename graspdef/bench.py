@@ -77,7 +77,7 @@ def run_benchmark(path: Path) -> dict:
     """Solve one benchmark file; return its comparison record."""
     t0 = time.perf_counter()
     spec = load_problem(path)
-    sol = solve_linear(spec.problem, backend=spec.backend)
+    sol = solve_linear(spec.problem, backend=spec.backend, precision=spec.precision)
     seconds = time.perf_counter() - t0
     rec = result_record(spec, sol)
     ref = spec.reference

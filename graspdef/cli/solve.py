@@ -68,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         from ..solve.linear import solve_linear
 
-        sol = solve_linear(spec.problem, backend=backend, precision=spec.solver.get("precision", "auto"))
+        sol = solve_linear(spec.problem, backend=backend, precision=spec.precision)
         progress(args, "solved: " + ", ".join(f"{k} {v:.2f} s" for k, v in sol.timings.items())
                  + ("; a single-precision factor, refined in double" if sol.kkt.precision == "mixed" else ""))
     out = write_run(args.out, spec, sol, Path(args.problem).read_text())

@@ -91,6 +91,7 @@ class ProblemSpec:
     reference: dict = field(default_factory=dict)
     source: dict = field(default_factory=dict)
     solver: dict = field(default_factory=dict)
+    precision: str = "auto"      # a linear solve's factor ([solver] precision; graspdef.solve.sparse.KKTSystem)
 
 
 @dataclass(frozen=True)
@@ -280,8 +281,9 @@ def load_problem(path: str | Path, backend: str | None = None) -> ProblemSpec:
     # the [solver] table first: its backend decides the memory check before the mesh is built
     file_backend, ncol, gamma, opts = _solver(doc.table("solver", required=False), units)
     ooc = (backend or file_backend) == "pardiso-ooc"
+    precision = opts.get("precision", "auto")
     # the memory check's kind of solve: a linear one's factor precision, or None for a path
-    linear = opts.get("precision", "auto") if opts.get("type", "linear") == "linear" else None
+    linear = precision if opts.get("type", "linear") == "linear" else None
     geo = doc.table("geometry")
     mesh = _geometry(geo, units, p.parent, ooc, linear)
     material = _material(doc.table("material"), units)
@@ -403,4 +405,4 @@ def load_problem(path: str | Path, backend: str | None = None) -> ProblemSpec:
     except GraspdefError as exc:
         raise type(exc)(f"{p}: {exc}") from None
     return ProblemSpec(problem, str(doc.get("name", p.stem)), units.length, units.force, ls, fs, file_backend,
-                       dict(ref), dict(doc), opts)
+                       dict(ref), dict(doc), opts, precision)

@@ -84,7 +84,7 @@ class LiveModel:
             self.u = None                                  # (3 n_control,) current converged state
             self.lam = None
         else:
-            self.linear = LinearResponse(self.problem, backend)
+            self.linear = LinearResponse(self.problem, backend, self.spec.precision)
             self.modulus_ok = True
             self.lam_end = 1.0
         self.seconds_setup = time.perf_counter() - t0

@@ -85,7 +85,8 @@ def test_nitsche_gamma_reaches_the_problem_and_applies_to_linear_files(tmp_path)
 
 
 def test_precision_reaches_the_linear_solve_and_its_record(tmp_path):
-    """``[solver] precision`` (a linear file's) is what ``graspdef solve`` factorises with, and
+    """``[solver] precision`` (a linear file's, ``ProblemSpec.precision``: also what ``graspdef
+    bench linear`` and the viewer's live re-solves use) is what ``graspdef solve`` factorises with, and
     result.json says which factor solved it; the two give the same centre deflection to 1e-9."""
     import json
 
@@ -98,5 +99,7 @@ def test_precision_reaches_the_linear_solve_and_its_record(tmp_path):
         assert main(["-q", "solve", str(f), "--out", str(tmp_path / precision)]) == 0
         rec = json.loads((tmp_path / precision / "result.json").read_text())
         assert rec["solver"]["precision"] == precision
+        assert load_problem(f).precision == precision            # the one value every linear consumer reads
         out[precision] = rec["probes"]["centre"]["displacement"][2]
     assert out["double"] != 0 and abs(out["mixed"] / out["double"] - 1) < 1e-9, out
+    assert load_problem(tmp_path / "double.toml").precision == "double" and _load(tmp_path, BASE).precision == "auto"
