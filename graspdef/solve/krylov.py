@@ -23,8 +23,8 @@ def gmres(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, atol: float,
     M^-1 v (identity if None; its images are kept, so x costs no further application).  With
     ``converged`` False, x is still the best of the ``maxiter``-dimensional space."""
     beta = float(np.linalg.norm(b))
-    if beta <= atol:
-        return np.zeros_like(b), 0, beta, True
+    if beta <= atol or maxiter < 1:
+        return np.zeros_like(b), 0, beta, beta <= atol
     V = [b / beta]
     Z = []
     Hs = np.zeros((maxiter + 1, maxiter))

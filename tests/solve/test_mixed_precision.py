@@ -86,10 +86,15 @@ def test_solve_linear_mixed_gives_the_double_answer_and_auto_picks_by_size(monke
     assert solve_linear(pr).kkt.precision == "double"
 
 
-def test_an_ill_conditioned_system_falls_back_to_a_double_factor():
+def test_an_ill_conditioned_system_falls_back_to_a_double_factor(monkeypatch):
     """cond(K) = 1e10, beyond single precision (6e-8): the single factor cannot refine the solve
     to MIXED_BACKWARD_TOL; the system refactors in double (``single`` becomes False, one more
-    factorisation counted) and the answer is the exact one to cond x eps, as a double system's."""
+    factorisation counted) and the answer is the exact one to cond x eps, as a double system's.
+    GMRES-IR is switched off here: on a 61-unknown system its 2 x 30 Krylov iterations nearly span
+    the whole space, and whether they reach the acceptance at cond 1e10 depended on the last bits of
+    the single factor (they did on this machine with today's wheels, 2026-11-27, and not in CI at stop 42); the
+    fallback itself is what is tested, GMRES-IR in the next test."""
+    monkeypatch.setattr(S, "MIXED_GMRES", 0)
     rng = np.random.default_rng(0)
     n = 60
     Q, _ = np.linalg.qr(rng.standard_normal((n, n)))
