@@ -222,7 +222,8 @@ def run_nonlinear_benchmark(path: Path, progress: Callable[[str], None] = lambda
     context = _context(path, ref)
     opts = benchmark_path_options(spec, context)
     sol = solve_nonlinear(spec.problem, opts, backend=spec.backend,
-                          progress=lambda i: progress(f"    point {i['step']}: load factor {i['load_factor']:.4g}"))
+                          progress=lambda i: progress(f"    point {i['step']}: load factor {i['load_factor']:.4g}"),
+                          precision=spec.precision)
     seconds = time.perf_counter() - t0
     n_control = int(spec.problem.shell.mesh.n_real)
     tol = ref.get("tolerance")

@@ -47,12 +47,14 @@ def run(args: argparse.Namespace) -> int:
 
         try:
             sol = solve_nonlinear(spec.problem, path_options(spec.solver), backend=backend,
-                                  progress=lambda info: _path_progress(args, info))
+                                  progress=lambda info: _path_progress(args, info), precision=spec.precision)
         except PathStopped as exc:
             if not exc.solution.path:                # nothing converged (refused at zero load): nothing to write
                 raise
             sol, stopped = exc.solution, exc
-        progress(args, f"path: {len(sol.path) - 1} points, {sol.n_factorisations} factorisations, "
+        single = (f" ({sol.n_single} single-precision, refined in double, their inertia certified)"
+                  if sol.n_single else "")
+        progress(args, f"path: {len(sol.path) - 1} points, {sol.n_factorisations} factorisations{single}, "
                        f"{sol.timings.get('total', 0.0):.1f} s")
         for cp in sol.critical_points:
             jump = cp.get("jump")

@@ -91,7 +91,7 @@ class ProblemSpec:
     reference: dict = field(default_factory=dict)
     source: dict = field(default_factory=dict)
     solver: dict = field(default_factory=dict)
-    precision: str = "auto"      # a linear solve's factor ([solver] precision; graspdef.solve.sparse.KKTSystem)
+    precision: str = "auto"      # the factors' precision ([solver] precision; graspdef.solve.sparse.KKTSystem)
 
 
 @dataclass(frozen=True)
@@ -260,9 +260,6 @@ def _solver(solver: Table, units: FileUnits) -> tuple[str, int, float, dict]:
             opts[k] = solver.number(k)
     solver.string("type", "linear", choices=("linear", "nonlinear"))
     solver.string("precision", "auto", choices=PRECISIONS)
-    if opts.get("type", "linear") == "nonlinear" and "precision" in opts:
-        raise solver.error("precision only applies to type = \"linear\": a path's tangents are factorised in "
-                           "double precision, because their inertia decides its stability")
     path_keys = set(opts) - {"type", "backend", "precision", "collocation", "nitsche_gamma"}
     if opts.get("type", "linear") == "linear" and path_keys:
         raise solver.error(f"{', '.join(sorted(path_keys))} only apply to type = \"nonlinear\"")

@@ -18,6 +18,13 @@ gradient of the internal terms (the shell's own elastic and support forces).
 Each linearised step solves the KKT system of the Hessian H (+ rank-one parts, by the Woodbury
 identity) and reports its inertia: the equilibrium is stable when the KKT matrix has exactly
 m negative eigenvalues (m constraints), i.e. H is positive definite on the null space of C.
+
+``precision`` "mixed" (or "auto" from 20,000 unknowns): the tangents are factorised in single
+precision (about 0.6 x the time and half the memory of a double factor); a factor whose inertia
+is reported is first certified (:meth:`graspdef.solve.sparse.KKTSystem.certify_inertia`: else it is
+refactorised in double), and the solves are refined only to what the caller needs (a predictor's
+or the Woodbury vectors' relative residual 1e-8, the acceptance of a double solve; a Newton
+step's forcing tolerance, ``PathSolver.newton``), not to a double solve's backward error.
 """
 from __future__ import annotations
 
@@ -99,8 +106,11 @@ def roundoff_floor(H: sp.csr_matrix, x: np.ndarray) -> float:
 class Equilibrium:
     """Energy, residual and tangent solves of a :class:`Problem` (see the module docstring)."""
 
-    def __init__(self, problem: Problem, backend: str = "auto", terms: list[EnergyTerm] | None = None):
-        """``terms``: the energy terms to sum (default ``problem.energy_terms()``)."""
+    def __init__(self, problem: Problem, backend: str = "auto", terms: list[EnergyTerm] | None = None,
+                 precision: str = "double"):
+        """``terms``: the energy terms to sum (default ``problem.energy_terms()``); ``precision``:
+        the tangents' factorisation (:class:`graspdef.solve.sparse.KKTSystem`; a single-precision
+        factor's inertia is certified before it is reported, :meth:`factor`)."""
         self.problem = problem
         shell = problem.shell
         self.X = shell.rest_positions.copy()
@@ -108,7 +118,7 @@ class Equilibrium:
         self.terms = list(problem.energy_terms() if terms is None else terms)
         self.C, self.labels, self.g = problem.constraints(with_targets=True)
         self.m = self.C.shape[0]
-        self.kkt = KKTSystem(self.C, backend)
+        self.kkt = KKTSystem(self.C, backend, precision)
         self._CCt = spla.splu((self.C @ self.C.T).tocsc()) if self.m else None
         self.n_hessians = 0           # order-2 evaluations
         self.n_krylov = 0             # GMRES iterations of inexact Newton steps (one back-substitution each)
@@ -182,16 +192,22 @@ class Equilibrium:
         return lam * self.g - self.C @ u if self.m else np.zeros(0)
 
     # ---- tangent solves ------------------------------------------------------------------------
-    def factor(self, state: State) -> int | None:
+    def factor(self, state: State, inertia: bool = True) -> int | None:
         """Factor the KKT matrix of the state's Hessian; returns the inertia excess (negative
-        eigenvalues of H on the constraint null space; 0 = stable) or None (no inertia)."""
+        eigenvalues of H on the constraint null space; 0 = stable) or None (no inertia).
+        ``inertia=False``: the caller will not report this factor's inertia (a Newton iterate far
+        from equilibrium), so a single-precision factor's is neither certified nor returned (None)."""
         self.kkt.factor(state.hessian)
         self._lowrank = None
-        neg = self.kkt.negative_pivots(self.m)      # an unexpected inertia is checked once robustly
+        if inertia or not self.kkt.single:
+            self.kkt.certify_inertia()              # a single factor's inertia, or a double factor
+            neg = self.kkt.negative_pivots(self.m)  # an unexpected inertia is checked once robustly
+        else:
+            neg = None
         if state.rank_one:
             V = np.stack([v for _, v in state.rank_one], axis=1)             # (n, k)
             c = np.array([c for c, _ in state.rank_one])
-            W, _, _ = self.kkt.solve(V)                                       # A^-1 [V; 0]
+            W, _, _ = self.kkt.solve(V, exact=False)                          # A^-1 [V; 0]
             S = np.diag(1.0 / c) + V.T @ W                                    # C^-1 + V^T A^-1 V
             self._lowrank = (V, W, S)
             if neg is not None:
@@ -200,14 +216,25 @@ class Equilibrium:
                 neg = neg + int((np.linalg.eigvalsh(-S) < 0).sum()) - int((c > 0).sum())
         return None if neg is None else neg - self.m
 
-    def solve(self, rhs: np.ndarray, g: np.ndarray | None = None, rtol: float = 1e-8) -> np.ndarray:
+    def solve(self, rhs: np.ndarray, g: np.ndarray | None = None, rtol: float = 1e-8,
+              exact: bool = False) -> np.ndarray:
         """Solve (H + sum c v v^T) du + C^T l = rhs, C du = g with the last factorisation;
         ``rhs`` (n,) or (n, k); ``rtol``: the largest relative residual accepted (a nearly singular
-        tangent, at a critical point, needs a looser one for inverse iteration)."""
-        du, _, _ = self.kkt.solve(rhs, g, rtol=rtol)
+        tangent, at a critical point, needs a looser one for inverse iteration).  A single-precision
+        factor's solve stops refining once its relative residual is ``rtol`` -- what a double
+        factor's solve is accepted at, and all that a path's predictors and Newton steps need --
+        unless ``exact`` (then it goes on to a double solve's backward error,
+        :meth:`graspdef.solve.sparse.KKTSystem.solve`); a double factor's solve is the same either way."""
+        du, _, _ = self.kkt.solve(rhs, g, rtol=rtol, exact=exact)
         if self._lowrank is not None:
             V, W, S = self._lowrank
             du = du - W @ np.linalg.solve(S, V.T @ du)
+        if not exact and self.m and self.kkt.single:
+            # an inexact solve meets the supports only to its tolerance: the least-squares
+            # correction onto C du = g (what the Newton loop's feasibility test and the energy
+            # line search assume; without it they were skipped, on the 10k ball one more factorisation)
+            gg = np.zeros((self.m,) + du.shape[1:]) if g is None else np.asarray(g, float).reshape((self.m,) + du.shape[1:])
+            du = du + self.C.T @ self._CCt.solve(gg - self.C @ du)
         if not np.all(np.isfinite(du)):
             raise SolverError("the tangent solve produced non-finite values")
         return du

@@ -58,6 +58,12 @@ def _refuse_load_control_options(names) -> None:
         raise ProblemError(f"{', '.join(names)} {'is an option' if len(names) == 1 else 'are options'} of "
                            "load-controlled paths (method 'load'); an arc-length path sets its steps by arc "
                            "length (steps, max_growth, desired_iterations) and follows limit points itself")
+#: Forcing term of a Newton step solved with a single-precision factor (PathSolver.newton's
+#: ``direction``): its relative residual is at most this times min(rel, 0.1) of the projected one
+NEWTON_FORCING = 0.1
+#: ... and of one on a reused (earlier) tangent, which contracts the residual by ~0.01-0.9 per step
+STALE_FORCING = 1e-3
+
 #: Loosest forcing term of an inexact Newton step (|F + J s| <= eta |F|; Eisenstat & Walker 1996)
 KRYLOV_ETA_MAX = 0.1
 
@@ -279,7 +285,10 @@ class NonlinearSolution(DisplacementField):
         ``extra["converged_by"]`` the path says why every step stopped where it did
     timings : seconds;  n_factorisations : tangent factorisations;  n_hessians : Hessian
         evaluations;  n_back_substitutions : back-substitutions (each right-hand side);
-        n_krylov : GMRES iterations of inexact Newton steps;  n_inexact : inexact Newton steps
+        n_krylov : GMRES iterations of inexact Newton steps;  n_inexact : inexact Newton steps;
+        n_single : of the factorisations, single-precision ones (``precision`` "mixed", or "auto"
+        from 20,000 unknowns; the rest double);  n_certificates : inertias of single-precision
+        factors certified (graspdef.solve.sparse.KKTSystem.certify_inertia)
     """
 
     problem: Problem
@@ -295,6 +304,8 @@ class NonlinearSolution(DisplacementField):
     n_back_substitutions: int = 0
     n_krylov: int = 0
     n_inexact: int = 0
+    n_single: int = 0
+    n_certificates: int = 0
 
     @property
     def u(self) -> np.ndarray:
@@ -327,7 +338,8 @@ class NonlinearSolution(DisplacementField):
         the ``events`` (every attempt cut, every bracket not narrowed, in words) and the
         ``critical_points`` (their probes as lists)."""
         return {"load_factor": self.load_factor, "n_points": len(self.path), "newton_iterations": self.iterations(),
-                "n_factorisations": self.n_factorisations, "events": [dict(e) for e in self.events],
+                "n_factorisations": self.n_factorisations, "n_single_precision_factorisations": self.n_single,
+                "events": [dict(e) for e in self.events],
                 "critical_points": [dict(cp, probes={k: np.asarray(v).tolist() for k, v in cp["probes"].items()})
                                     for cp in self.critical_points]}
 
@@ -354,19 +366,21 @@ class PathSolver:
     """Runs one path (see the module docstring); use :func:`solve_nonlinear`."""
 
     def __init__(self, problem: Problem, options: PathOptions, backend: str = "auto",
-                 progress: Callable[[dict], None] | None = None, terms: list | None = None):
+                 progress: Callable[[dict], None] | None = None, terms: list | None = None,
+                 precision: str = "auto"):
         """``terms``: the energy terms to follow (default ``problem.energy_terms()``; e.g.
         ``problem.energy_terms("rest")`` for the linear shell with contact)."""
         self.problem = problem
         self.opt = options
         self.progress = progress
-        self.eq = Equilibrium(problem, backend, terms)
+        self.eq = Equilibrium(problem, backend, terms, precision)
         self.gas = [t for t in self.eq.terms if isinstance(t, EnclosedGas)]   # pre-loaded at lam = 0
         self.q_norm = 0.0
         self.inertia_residual = 0.0
         self.floor = 0.0                  # round-off level of the residual [N] (the latest Hessian's)
         self.converged_by: str | None = None
         self.residual = (0.0, 0.0)        # (relative residual, relative floor) of the last test
+        self.residual_norm = 0.0          # |projected residual| of the last test [N]
         self.last_step = np.inf           # |last correction| / |u| of the current Newton solve
         self.switched = False             # a branch switch has been made (one per path)
         self.n_inexact = 0                # inexact (GMRES) Newton steps taken
@@ -427,6 +441,7 @@ class PathSolver:
         ok = how is not None and float(np.linalg.norm(cres)) <= 1e-9 * cscale
         self.converged_by = how if ok else None
         self.residual = (rn / scale, self.floor / scale)
+        self.residual_norm = rn
         return ok, rn / scale
 
     def newton(self, u0: np.ndarray, lam: float, factored: bool = False, patient: bool = False,
@@ -483,6 +498,21 @@ class PathSolver:
         far = False                 # a step on a fresh tangent did not contract: no inexact steps
         self.last_step = np.inf
 
+        def direction(st, cres, fresh=True):
+            """The Newton step on the last factorisation: with a single-precision factor, solved to
+            a forcing tolerance (an inexact Newton step, |F + J s| <= eta |F|; Dembo, Eisenstat &
+            Steihaug 1982) instead of refined to a double solve's backward error: on a tangent
+            factorised at this iterate (``fresh``) eta = NEWTON_FORCING min(rel, 0.1) of the
+            projected residual, below Newton's own O(|F|^2) term; on a reused one eta =
+            STALE_FORCING, below what the stale tangent itself leaves.  A double factor's solve is
+            as always."""
+            if not eq.kkt.single:
+                return eq.solve(-st.gradient, cres)
+            gn = max(float(np.linalg.norm(st.gradient)), 1e-300)
+            eta_n = NEWTON_FORCING * min(rel, 0.1) if fresh else STALE_FORCING
+            rtol = max(1e-8, eta_n * self.residual_norm / gn)
+            return eq.solve(-st.gradient, cres, rtol=min(rtol, 0.1), exact=False)
+
         def refresh(u, st, cres, tight=False, keep_near=False):
             """A step on the tangent at u (``st`` its state): inexact (GMRES) if it converges
             within ``krylov`` iterations (to krylov_rtol if ``tight``), else on a fresh
@@ -497,7 +527,7 @@ class PathSolver:
                     e = max(e, 0.9 * eta ** 2)
                 eta = opt.krylov_rtol if tight else float(np.clip(e, opt.krylov_rtol,
                                                                   max(KRYLOV_ETA_MAX, opt.krylov_rtol)))
-                du = eq.solve(-st.gradient, cres)
+                du = direction(st, cres, fresh=False)
                 di = eq.inexact_step(u, lam, st, -st.gradient, du, eta, opt.krylov)
                 if di is not None:
                     self.n_inexact += 1
@@ -505,11 +535,11 @@ class PathSolver:
                     return st, di, False
             if st.hessian is None:
                 st = eq.evaluate(u, lam, 2)
-            inst = eq.factor(st)
+            inst = eq.factor(st, inertia=not keep_near and rel <= opt.inertia_rtol)
             if not keep_near:
                 near = (inst, rel) if rel <= opt.inertia_rtol else None
             inexact, hist = False, []
-            return st, eq.solve(-st.gradient, cres), True
+            return st, direction(st, cres), True
 
         max_it = 4 * opt.max_iterations if patient else opt.max_iterations if budget is None else budget
         for it in range(max_it + 1):
@@ -552,11 +582,11 @@ class PathSolver:
                 st, du, need_h = refresh(u, st, cres, tight=inexact and poor)
                 fresh = True
             if need_h and not fresh:
-                inst = eq.factor(st)
+                inst = eq.factor(st, inertia=rel <= opt.inertia_rtol)
                 near = (inst, rel) if rel <= opt.inertia_rtol else None
                 hist, inexact = [], False
             if not fresh:
-                du = eq.solve(-st.gradient, cres)
+                du = direction(st, cres, fresh=need_h)
             # the supports hold to solve precision: the step need not restore them, and the energy
             # is a merit function along it
             feasible = float(np.linalg.norm(cres)) <= 1e-8 * max(float(np.linalg.norm(u)), float(np.linalg.norm(du)),
@@ -612,7 +642,7 @@ class PathSolver:
 
     def _tangent(self, u, lam):
         st = self.eq.evaluate(u, lam, 2)
-        self.eq.factor(st)
+        self.eq.factor(st, inertia=False)
         return self.eq.solve(st.load, self.eq.g)
 
     def _emit(self, sol, pt, dl=None):
@@ -702,6 +732,8 @@ class PathSolver:
         sol.n_factorisations = self.eq.n_factorisations
         sol.n_hessians = self.eq.n_hessians
         sol.n_back_substitutions = self.eq.kkt.n_back
+        sol.n_single = self.eq.kkt.n_single
+        sol.n_certificates = self.eq.kkt.certificates
         sol.n_krylov = self.eq.n_krylov
         sol.n_inexact = self.n_inexact
         sol.completed = sol.stop_reason is None
@@ -1145,7 +1177,7 @@ class PathSolver:
         """One Crisfield step of arc length dl; returns (u, lam, iterations, state, instability)."""
         eq, opt = self.eq, self.opt
         st = eq.evaluate(u, lam, 2)
-        eq.factor(st)
+        eq.factor(st, inertia=False)
         t = eq.solve(st.load, eq.g)
         tn = float(np.linalg.norm(t))
         if tn == 0:
@@ -1189,13 +1221,14 @@ class PathSolver:
 
 
 def solve_nonlinear(problem: Problem, options: PathOptions | None = None, backend: str = "auto",
-                    progress: Callable[[dict], None] | None = None, allow_partial: bool = False) -> NonlinearSolution:
+                    progress: Callable[[dict], None] | None = None, allow_partial: bool = False,
+                    precision: str = "auto") -> NonlinearSolution:
     """Follow the equilibrium path of ``problem`` (see the module docstring).
 
     Raises PathStopped (with ``.solution``, the converged part) when the path cannot reach
     ``options.max_load``, unless ``allow_partial``."""
     opt = options or PathOptions()
-    sol = PathSolver(problem, opt, backend, progress).run()
+    sol = PathSolver(problem, opt, backend, progress, precision=precision).run()
     if not sol.completed and not allow_partial:
         raise PathStopped(f"the load path stopped at load factor {sol.load_factor:.6g} after "
                           f"{len(sol.path) - 1} steps: {sol.stop_reason}", sol)

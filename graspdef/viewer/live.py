@@ -77,7 +77,8 @@ class LiveModel:
             opts = path_options(self.spec.solver)
             self.options = opts
             self.solver = PathSolver(self.problem, PathOptions(method="load", max_iterations=max_iterations,
-                                                               tol=opts.tol, line_search=True), backend)
+                                                               tol=opts.tol, line_search=True), backend,
+                                     precision=self.spec.precision)
             eq = self.solver.eq
             self.modulus_ok = not (eq.m and np.any(eq.g)) and not any(isinstance(t, EnclosedGas) for t in eq.terms)
             self.lam_end = float((run.record.get("convergence") or {}).get("load_factor", opts.max_load))
@@ -119,7 +120,8 @@ class LiveModel:
         def progress(info):
             if should_stop():
                 raise Aborted("viewer closing")
-        return solve_nonlinear(self.problem, opts, self.backend, progress=progress, allow_partial=True)
+        return solve_nonlinear(self.problem, opts, self.backend, progress=progress, allow_partial=True,
+                               precision=self.spec.precision)
 
     # ---- requests --------------------------------------------------------------------------------
     def request(self, force_scale: float, modulus_scale: float) -> LiveResult:

@@ -55,9 +55,6 @@ def test_values_with_their_own_units_are_the_same(tmp_path):
     (('[[loads]]', '[solver]\ntype = "nonlin"\n[[loads]]'), r"\[solver\] unknown type 'nonlin' \(did you mean 'nonlinear'\?\)"),
     (('[[loads]]', '[solver]\nprecision = "single"\n[[loads]]'),
      r"\[solver\] unknown precision 'single'"),
-    (('[[loads]]', '[solver]\ntype = "nonlinear"\nprecision = "mixed"\n[[loads]]'),
-     r"p.toml: \[solver\] precision only applies to type = \"linear\": a path's tangents are factorised in double "
-     r"precision, because their inertia decides its stability"),
     (('nx = 4', 'nx = 4.0'), r"\[geometry\] nx must be an integer, got 4.0"),
     (('[units]', '[units'), r"p.toml: line \d+, column \d+: not valid TOML"),
 ])
@@ -103,3 +100,30 @@ def test_precision_reaches_the_linear_solve_and_its_record(tmp_path):
         out[precision] = rec["probes"]["centre"]["displacement"][2]
     assert out["double"] != 0 and abs(out["mixed"] / out["double"] - 1) < 1e-9, out
     assert load_problem(tmp_path / "double.toml").precision == "double" and _load(tmp_path, BASE).precision == "auto"
+
+
+def test_precision_reaches_a_nonlinear_path_and_its_record(tmp_path):
+    """A nonlinear file's ``[solver] precision`` is what its path's tangents are factorised with:
+    "mixed" gives single-precision factors (each one whose inertia became a point's stability
+    certified, graspdef.solve.sparse.KKTSystem.certify_inertia), result.json counts them, and the
+    centre deflection is the double path's to 1e-8 (both converge to the Newton tolerance); "auto"
+    is double at this size (below 20,000 unknowns)."""
+    import json
+
+    from graspdef.cli import main
+
+    out = {}
+    for precision in ("mixed", "double", "auto"):
+        f = tmp_path / f"{precision}.toml"
+        f.write_text(BASE.replace("[[loads]]", f'[solver]\ntype = "nonlinear"\nsteps = 2\nprecision = "{precision}"\n[[loads]]', 1)
+                     .replace("p = 0.01", "p = 0.0005"))
+        assert load_problem(f).precision == precision
+        assert main(["-q", "solve", str(f), "--out", str(tmp_path / precision)]) == 0
+        rec = json.loads((tmp_path / precision / "result.json").read_text())
+        conv = rec["convergence"]
+        out[precision] = (rec["probes"]["centre"]["displacement"][2], conv["n_single_precision_factorisations"],
+                          conv["n_factorisations"])
+    w_m, single_m, n_m = out["mixed"]
+    w_d, single_d, _ = out["double"]
+    assert single_m == n_m > 0 and single_d == 0 and out["auto"][1] == 0
+    assert w_d != 0 and abs(w_m / w_d - 1) < 1e-8, out
