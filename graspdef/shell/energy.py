@@ -88,14 +88,14 @@ class _Schedule:
 class _GroupData:
     """Contiguous basis derivatives of one face group for the kernels and its schedule."""
 
-    def __init__(self, g, x0: np.ndarray):
+    def __init__(self, g, schedule: "_Schedule"):
         self.stencils = np.ascontiguousarray(g.stencils, dtype=np.int64)
         self.D = np.ascontiguousarray(np.concatenate([g.dN, g.ddN], axis=-1), dtype=float)   # (f|1, q, S, 5)
         S = self.D.shape[2]
         self.Dt = np.zeros(self.D.shape[:2] + (5, -(-S // 4) * 4))                          # (f|1, q, 5, S4)
         self.Dt[..., :S] = np.swapaxes(self.D, -1, -2)
         self.dstride = 0 if g.dN.shape[0] == 1 else 1
-        self.schedule = _Schedule(self.stencils, x0)
+        self.schedule = schedule
 
 
 class BlockPattern:
@@ -199,8 +199,7 @@ class ShellEnergy:
     @property
     def _groups(self) -> list[_GroupData]:
         if self._gdata is None:
-            x0 = np.asarray(self.shell.rest_positions, dtype=float)
-            self._gdata = [_GroupData(g, x0) for g in self.shell.basis.groups]
+            self._gdata = [_GroupData(g, sch) for g, sch in zip(self.shell.basis.groups, self.shell.face_schedules)]
         return self._gdata
 
     def _points(self, x: np.ndarray, order: int):

@@ -17,92 +17,108 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..compiled import kernel
+from ..compiled import kernel, prange
 from .energy import BlockPattern, block_pattern
 from .model import Shell
 
 _CHUNK = 4096
 
 
-@kernel(aot=("f8(f8[:,::1], i8[:,::1], f8[:,:,::1], f8[:,:,:,::1], f8[::1], i8, i8, i8[::1], i8[::1], i8[::1], f8[:,::1], f8[::1])",))
-def _volume_terms(x, stencils, N, dN, w, nstride, order, index, base, bstride, grad, data):
+@kernel(parallel=True, work=1, aot=("f8(f8[:,::1], i8[:,::1], f8[:,:,::1], f8[:,:,:,::1], f8[::1], i8, i8, i8[::1], i8[::1], i8[::1], f8[:,::1], f8[::1], i8[::1], i8[::1], i8[::1], i8[::1], f8[::1])",))
+def _volume_terms(x, stencils, N, dN, w, nstride, order, index, base, bstride, grad, data,
+                  forder, bstart, cblocks, cstart, vblock):
     """Fused value / gradient (order >= 1) / Hessian (order 2, added into the scalar CSR ``data``
     of the shell's block pattern: block p = index[(f S + s) S + t], entry (a, b) at
-    base[p] + a bstride[p] + b) of V over one face group; sequential (no scatter races).
-    N (f|1, q, S), dN (f|1, q, S, 2), w (q,) including the 1/3; returns V."""
+    base[p] + a bstride[p] + b) of V over one face group; returns V.
+    N (f|1, q, S), dN (f|1, q, S, 2), w (q,) including the 1/3.
+
+    Faces are visited as the shell's assembly visits them (graspdef.shell.energy._Schedule): in
+    ``forder``, in blocks (bstart: offsets into forder) of one colour (cblocks[cstart[c]:cstart[c +
+    1]] the blocks of colour c), and blocks of one colour share no control vertex, so they run in
+    parallel without write races; each block's volume goes to vblock[block] and V is their sum in
+    block order -- the same numbers for any number of threads, serial or parallel build."""
     nf, S = stencils.shape
     nq = w.shape[0]
-    V = 0.0
-    p = np.empty((nq, 3))
-    a1 = np.empty((nq, 3))
-    a2 = np.empty((nq, 3))
-    for f in range(nf):
-        fb = f * nstride
-        for q in range(nq):
-            for d in range(3):
-                sp_ = 0.0
-                s1 = 0.0
-                s2 = 0.0
-                for s in range(S):
-                    xv = x[stencils[f, s], d]
-                    sp_ += N[fb, q, s] * xv
-                    s1 += dN[fb, q, s, 0] * xv
-                    s2 += dN[fb, q, s, 1] * xv
-                p[q, d] = sp_
-                a1[q, d] = s1
-                a2[q, d] = s2
-            m0 = a1[q, 1] * a2[q, 2] - a1[q, 2] * a2[q, 1]
-            m1 = a1[q, 2] * a2[q, 0] - a1[q, 0] * a2[q, 2]
-            m2 = a1[q, 0] * a2[q, 1] - a1[q, 1] * a2[q, 0]
-            V += w[q] * (p[q, 0] * m0 + p[q, 1] * m1 + p[q, 2] * m2)
-            if order >= 1:
-                # dV = w [N_s (a1 x a2) + dN1_s (a2 x p) + dN2_s (p x a1)]
-                b0 = a2[q, 1] * p[q, 2] - a2[q, 2] * p[q, 1]
-                b1 = a2[q, 2] * p[q, 0] - a2[q, 0] * p[q, 2]
-                b2 = a2[q, 0] * p[q, 1] - a2[q, 1] * p[q, 0]
-                c0 = p[q, 1] * a1[q, 2] - p[q, 2] * a1[q, 1]
-                c1 = p[q, 2] * a1[q, 0] - p[q, 0] * a1[q, 2]
-                c2 = p[q, 0] * a1[q, 1] - p[q, 1] * a1[q, 0]
-                for s in range(S):
-                    Ns, d1, d2 = w[q] * N[fb, q, s], w[q] * dN[fb, q, s, 0], w[q] * dN[fb, q, s, 1]
-                    r = stencils[f, s]
-                    grad[r, 0] += Ns * m0 + d1 * b0 + d2 * c0
-                    grad[r, 1] += Ns * m1 + d1 * b1 + d2 * c1
-                    grad[r, 2] += Ns * m2 + d1 * b2 + d2 * c2
-        if order < 2:
-            continue
-        for s in range(S):
-            for t in range(s + 1, S):
-                v0 = 0.0
-                v1 = 0.0
-                v2 = 0.0
+    ncol = cstart.shape[0] - 1
+    for col in range(ncol):
+        for bi in prange(cstart[col], cstart[col + 1]):
+            blk = cblocks[bi]
+            p = np.empty((nq, 3))
+            a1 = np.empty((nq, 3))
+            a2 = np.empty((nq, 3))
+            Vb = 0.0
+            for k in range(bstart[blk], bstart[blk + 1]):
+                f = forder[k]
+                fb = f * nstride
                 for q in range(nq):
-                    Ns, Nt = N[fb, q, s], N[fb, q, t]
-                    d1s, d1t = dN[fb, q, s, 0], dN[fb, q, t, 0]
-                    d2s, d2t = dN[fb, q, s, 1], dN[fb, q, t, 1]
-                    ca2 = w[q] * (d1s * Nt - Ns * d1t)
-                    ca1 = w[q] * (Ns * d2t - d2s * Nt)
-                    cp = w[q] * (d2s * d1t - d1s * d2t)
-                    v0 += ca2 * a2[q, 0] + ca1 * a1[q, 0] + cp * p[q, 0]
-                    v1 += ca2 * a2[q, 1] + ca1 * a1[q, 1] + cp * p[q, 1]
-                    v2 += ca2 * a2[q, 2] + ca1 * a1[q, 2] + cp * p[q, 2]
-                # block (s, t) = [v]_x, block (t, s) = its transpose
-                k = index[(f * S + s) * S + t]
-                o, st_ = base[k], bstride[k]
-                data[o + 1] -= v2
-                data[o + 2] += v1
-                data[o + st_] += v2
-                data[o + st_ + 2] -= v0
-                data[o + 2 * st_] -= v1
-                data[o + 2 * st_ + 1] += v0
-                k = index[(f * S + t) * S + s]
-                o, st_ = base[k], bstride[k]
-                data[o + 1] += v2
-                data[o + 2] -= v1
-                data[o + st_] -= v2
-                data[o + st_ + 2] += v0
-                data[o + 2 * st_] += v1
-                data[o + 2 * st_ + 1] -= v0
+                    for d in range(3):
+                        sp_ = 0.0
+                        s1 = 0.0
+                        s2 = 0.0
+                        for s in range(S):
+                            xv = x[stencils[f, s], d]
+                            sp_ += N[fb, q, s] * xv
+                            s1 += dN[fb, q, s, 0] * xv
+                            s2 += dN[fb, q, s, 1] * xv
+                        p[q, d] = sp_
+                        a1[q, d] = s1
+                        a2[q, d] = s2
+                    m0 = a1[q, 1] * a2[q, 2] - a1[q, 2] * a2[q, 1]
+                    m1 = a1[q, 2] * a2[q, 0] - a1[q, 0] * a2[q, 2]
+                    m2 = a1[q, 0] * a2[q, 1] - a1[q, 1] * a2[q, 0]
+                    Vb += w[q] * (p[q, 0] * m0 + p[q, 1] * m1 + p[q, 2] * m2)
+                    if order >= 1:
+                        # dV = w [N_s (a1 x a2) + dN1_s (a2 x p) + dN2_s (p x a1)]
+                        b0 = a2[q, 1] * p[q, 2] - a2[q, 2] * p[q, 1]
+                        b1 = a2[q, 2] * p[q, 0] - a2[q, 0] * p[q, 2]
+                        b2 = a2[q, 0] * p[q, 1] - a2[q, 1] * p[q, 0]
+                        c0 = p[q, 1] * a1[q, 2] - p[q, 2] * a1[q, 1]
+                        c1 = p[q, 2] * a1[q, 0] - p[q, 0] * a1[q, 2]
+                        c2 = p[q, 0] * a1[q, 1] - p[q, 1] * a1[q, 0]
+                        for s in range(S):
+                            Ns, d1, d2 = w[q] * N[fb, q, s], w[q] * dN[fb, q, s, 0], w[q] * dN[fb, q, s, 1]
+                            r = stencils[f, s]
+                            grad[r, 0] += Ns * m0 + d1 * b0 + d2 * c0
+                            grad[r, 1] += Ns * m1 + d1 * b1 + d2 * c1
+                            grad[r, 2] += Ns * m2 + d1 * b2 + d2 * c2
+                if order < 2:
+                    continue
+                for s in range(S):
+                    for t in range(s + 1, S):
+                        v0 = 0.0
+                        v1 = 0.0
+                        v2 = 0.0
+                        for q in range(nq):
+                            Ns, Nt = N[fb, q, s], N[fb, q, t]
+                            d1s, d1t = dN[fb, q, s, 0], dN[fb, q, t, 0]
+                            d2s, d2t = dN[fb, q, s, 1], dN[fb, q, t, 1]
+                            ca2 = w[q] * (d1s * Nt - Ns * d1t)
+                            ca1 = w[q] * (Ns * d2t - d2s * Nt)
+                            cp = w[q] * (d2s * d1t - d1s * d2t)
+                            v0 += ca2 * a2[q, 0] + ca1 * a1[q, 0] + cp * p[q, 0]
+                            v1 += ca2 * a2[q, 1] + ca1 * a1[q, 1] + cp * p[q, 1]
+                            v2 += ca2 * a2[q, 2] + ca1 * a1[q, 2] + cp * p[q, 2]
+                        # block (s, t) = [v]_x, block (t, s) = its transpose
+                        kk = index[(f * S + s) * S + t]
+                        o, st_ = base[kk], bstride[kk]
+                        data[o + 1] -= v2
+                        data[o + 2] += v1
+                        data[o + st_] += v2
+                        data[o + st_ + 2] -= v0
+                        data[o + 2 * st_] -= v1
+                        data[o + 2 * st_ + 1] += v0
+                        kk = index[(f * S + t) * S + s]
+                        o, st_ = base[kk], bstride[kk]
+                        data[o + 1] += v2
+                        data[o + 2] -= v1
+                        data[o + st_] -= v2
+                        data[o + st_ + 2] += v0
+                        data[o + 2 * st_] += v1
+                        data[o + 2 * st_ + 1] -= v0
+            vblock[blk] = Vb
+    V = 0.0
+    for b in range(vblock.shape[0]):
+        V += vblock[b]
     return V
 
 
@@ -146,12 +162,13 @@ class EnclosedVolume:
         data = np.zeros(9 * pat.nnzb) if order == 2 else np.zeros(1)
         empty = np.zeros(1, np.int64)
         V = 0.0
-        for gi, g in enumerate(self.shell.basis.groups):
-            V += _volume_terms(x, np.ascontiguousarray(g.stencils), np.ascontiguousarray(g.N),
+        for gi, (g, sch) in enumerate(zip(self.shell.basis.groups, self.shell.face_schedules)):
+            V += _volume_terms(x, np.ascontiguousarray(g.stencils, dtype=np.int64), np.ascontiguousarray(g.N),
                                np.ascontiguousarray(g.dN), w, 0 if g.N.shape[0] == 1 else 1, order,
                                pat.maps[gi] if pat is not None else empty,
                                pat.base if pat is not None else empty, pat.stride if pat is not None else empty,
-                               grad, data)
+                               grad, data, sch.order, sch.bstart, sch.cblocks, sch.cstart,
+                               np.zeros(len(sch.bstart) - 1))
         H = None
         if order == 2:
             if hessian_scale != 1.0:
