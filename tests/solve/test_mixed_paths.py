@@ -13,14 +13,8 @@ import pytest
 import scipy.sparse as sp
 
 import graspdef.solve.sparse as S
-from graspdef.geometry import sphere
-from graspdef.problem.loads import PointLoad
-from graspdef.problem.potentials import EnclosedGas
-from graspdef.problem.problem import Problem
-from graspdef.problem.supports import RigidModes
-from graspdef.shell.hyperelastic import NeoHookean
-from graspdef.shell.model import Shell
 from graspdef.solve.nonlinear import PathOptions, solve_nonlinear
+from test_inexact_newton import _ball       # the bench's air-filled neo-Hookean ball pinched at its poles
 
 pytestmark = pytest.mark.skipif(not S.pardiso_available(), reason="single-precision factors need PARDISO")
 
@@ -104,17 +98,6 @@ def test_an_inexact_solve_stops_at_its_tolerance_and_a_double_solve_ignores_it()
     assert np.array_equal(a, e)
 
 
-def _ball(sub=3, force=20.0):
-    """The bench's air-filled neo-Hookean ball (R = 32.5 mm, t = 2.5 mm, 80 kPa) pinched at its poles."""
-    R, t = 0.0325, 0.0025
-    m = sphere(R, sub)
-    pr = Problem(Shell(m.vertices, m.faces, NeoHookean(1e6 / 3), t), [EnclosedGas(80e3)], [RigidModes()])
-    top, bot = pr.locate((0, 0, R)), pr.locate((0, 0, -R))
-    pr.loads += [PointLoad(top.face, top.bary, (0, 0, -force)), PointLoad(bot.face, bot.bary, (0, 0, force))]
-    pr.probes["top"] = top
-    return pr
-
-
 def test_a_mixed_path_is_the_double_path():
     """The 642-vertex air-filled ball pinched to 20 N: with single-precision tangents (precision
     "mixed") the path takes the same steps and Newton iterations, every point's stability is the
@@ -122,8 +105,8 @@ def test_a_mixed_path_is_the_double_path():
     Newton tolerance 1e-8 of the force scale).  Every factor is single, and each one whose inertia
     became a point's stability was certified."""
     opts = PathOptions(steps=20, max_steps=200)
-    mixed = solve_nonlinear(_ball(), opts, precision="mixed")
-    double = solve_nonlinear(_ball(), opts, precision="double")
+    mixed = solve_nonlinear(_ball(3, 20.0), opts, precision="mixed")
+    double = solve_nonlinear(_ball(3, 20.0), opts, precision="double")
     assert mixed.completed and double.completed
     assert mixed.load_factors().tolist() == double.load_factors().tolist()
     assert [p.stable for p in mixed.path] == [p.stable for p in double.path] and all(p.stable for p in mixed.path)
@@ -138,9 +121,9 @@ def test_auto_is_double_below_the_size_and_mixed_from_it(monkeypatch):
     """The default precision "auto" factorises a path's tangents in single precision from
     MIXED_MIN_UNKNOWNS unknowns on (the 642-vertex ball has 1,932), in double below."""
     opts = PathOptions(steps=20, max_steps=200, max_load=0.1)
-    assert solve_nonlinear(_ball(), opts).n_single == 0
+    assert solve_nonlinear(_ball(3, 20.0), opts).n_single == 0
     monkeypatch.setattr(S, "MIXED_MIN_UNKNOWNS", 1000)
-    sol = solve_nonlinear(_ball(), opts)
+    sol = solve_nonlinear(_ball(3, 20.0), opts)
     assert sol.n_single == sol.n_factorisations > 0
 
 
