@@ -52,8 +52,8 @@ def run(args: argparse.Namespace) -> int:
             if not exc.solution.path:                # nothing converged (refused at zero load): nothing to write
                 raise
             sol, stopped = exc.solution, exc
-        single = (f" ({sol.n_single} single-precision, refined in double, their inertia certified)"
-                  if sol.n_single else "")
+        single = (f" ({sol.n_single} in single precision, refined in double; {sol.n_certificates} of their "
+                  "inertias certified before use, a failed one refactorised in double)" if sol.n_single else "")
         progress(args, f"path: {len(sol.path) - 1} points, {sol.n_factorisations} factorisations{single}, "
                        f"{sol.timings.get('total', 0.0):.1f} s")
         for cp in sol.critical_points:
