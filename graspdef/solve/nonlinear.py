@@ -369,7 +369,9 @@ class PathSolver:
                  progress: Callable[[dict], None] | None = None, terms: list | None = None,
                  precision: str = "auto"):
         """``terms``: the energy terms to follow (default ``problem.energy_terms()``; e.g.
-        ``problem.energy_terms("rest")`` for the linear shell with contact)."""
+        ``problem.energy_terms("rest")`` for the linear shell with contact).  ``precision``: the
+        tangents' factors ("auto": single precision from 20,000 unknowns on, each inertia reported
+        from one certified first; :class:`graspdef.solve.equilibrium.Equilibrium`)."""
         self.problem = problem
         self.opt = options
         self.progress = progress
@@ -1226,7 +1228,8 @@ def solve_nonlinear(problem: Problem, options: PathOptions | None = None, backen
     """Follow the equilibrium path of ``problem`` (see the module docstring).
 
     Raises PathStopped (with ``.solution``, the converged part) when the path cannot reach
-    ``options.max_load``, unless ``allow_partial``."""
+    ``options.max_load``, unless ``allow_partial``.  ``precision``: "auto" | "mixed" | "double",
+    the tangents' factors (see :class:`PathSolver`)."""
     opt = options or PathOptions()
     sol = PathSolver(problem, opt, backend, progress, precision=precision).run()
     if not sol.completed and not allow_partial:
