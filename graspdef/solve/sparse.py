@@ -857,13 +857,17 @@ _PARDISO_IPARM = {
     10: 8,      # pivot perturbation 1e-8 (then refined; the true residual is checked)
     11: 1,      # symmetric scaling
     13: 2,      # weighted matching, improved variant (saddle-point systems)
-    21: 1,      # Bunch-Kaufman pivoting
+    21: 0,      # 1x1 diagonal pivots (the constraint rows' zero pivots are static-pivoted and
+                # then refined; Bunch-Kaufman 2x2 pivots, 21 = 1, are the first fallback): the 10k
+                # ball's single-precision factor 0.21-0.23 s against 0.30-0.33 s with them, the same
+                # inertia (README, "1x1 pivots")
     35: 1,      # zero-based indices (KKTSystem._call passes scipy's own)
 }
 
 #: PARDISO settings of a second factorisation when the first fails a check (a solve's residual and
-#: backward error, or an inertia other than the one expected): the standard weighted matching
-#: instead of the improved one.  The improved matching is faster (10k pinched cylinder: 1.95 vs
+#: backward error, or an inertia other than the one expected): Bunch-Kaufman 1x1 and 2x2 pivots
+#: instead of 1x1 pivots only (the defaults until 2026-11-28).  Then (the next two fallbacks) the
+#: standard weighted matching instead of the improved one, with Bunch-Kaufman pivots.  The improved matching is faster (10k pinched cylinder: 1.95 vs
 #: 2.26 s per factorisation, medians of 5), but its static pivoting is not backward-stable on
 #: every matrix: the 1/8 soda can at 96 x 96 cells with two collocation points per edge, with its
 #: nearly dependent support rows re-based into one orthonormal basis (as they then were), perturbs one pivot, counts
@@ -875,10 +879,11 @@ _PARDISO_IPARM = {
 #: settings perturb tiny pivots of the zero constraint block routinely (the pinched cylinder, the
 #: patch model) and the refined solution then passes its check.
 #: The settings tried after the defaults when a check fails, in this order (:meth:`KKTSystem.retry_robust`):
-#: the standard weighted matching (above), then the minimum-degree ordering instead of METIS (which
-#: factored the soda can's and the half-can's failing tangents exactly as well).
-_PARDISO_ROBUST = {13: 1}
-_PARDISO_FALLBACKS = (_PARDISO_ROBUST, {2: 0})
+#: Bunch-Kaufman pivots, then with them the standard weighted matching (above), then the
+#: minimum-degree ordering instead of METIS (which factored the soda can's and the half-can's
+#: failing tangents exactly as well).
+_PARDISO_ROBUST = {21: 1}
+_PARDISO_FALLBACKS = (_PARDISO_ROBUST, {21: 1, 13: 1}, {21: 1, 2: 0})
 
 
 def solve_kkt(K: sp.spmatrix, C: sp.spmatrix, f: np.ndarray, backend: str = "auto",
