@@ -7,8 +7,8 @@ path, per-step Newton iterations -- and their median.
                                             [--ref GIT_REF] [--out out/bench_nonlinear_speed.json]
 
 ``--ref``: also run the OLD code of that git ref (checked out into a temporary worktree), its runs
-interleaved with the NEW code's (the working tree), and print both side by side (one untimed small run
-of each tree first warms its numba cache).
+interleaved with the NEW code's (the working tree), and print both side by side (one untimed run of
+each tree, at up to 2,562 control vertices, first warms its numba cache).
 
 ``--krylov N`` (10 unless given): the path takes inexact Newton steps (PathOptions.krylov = N, off in
 the solver's default; code before them ignores it).  ``--krylov 0``: the solver's default path.
@@ -118,8 +118,13 @@ def main() -> None:
     a = ap.parse_args()
     with code_trees(ROOT, a.ref, "bench_nonlinear_") as trees:
         runs: dict[str, list] = {k: [] for k in trees}
-        for tree in trees.values():            # warm numba's on-disk cache of each tree (not timed)
-            _run(argparse.Namespace(**{**vars(a), "subdivisions": 2, "steps": 2}), tree)
+        # warm numba's on-disk cache of each tree (not timed), on a mesh whose kernels take the same
+        # build as the timed one's: from 5,120 faces (subdivisions 4) on the parallel JIT build
+        # (graspdef.compiled.SERIAL_MAX).  Warmed at subdivisions 2 (the serial ahead-of-time build),
+        # a fresh OLD worktree compiled its parallel kernels in its first timed run: 32-35 s against
+        # 15-17 s for the next ones (2026-11-28)
+        for tree in trees.values():
+            _run(argparse.Namespace(**{**vars(a), "subdivisions": min(a.subdivisions, 4), "steps": 2}), tree)
         for k in range(a.runs):
             for label, tree in trees.items():
                 r = _run(a, tree)
