@@ -868,8 +868,9 @@ _PARDISO_IPARM = {
 #: backward error, or an inertia other than the one expected): Bunch-Kaufman 1x1 and 2x2 pivots
 #: instead of 1x1 pivots only (Bunch-Kaufman was the default until 2026-11-28).  Then, with
 #: Bunch-Kaufman pivots, the standard weighted matching instead of the improved one, and then the
-#: minimum-degree ordering instead of METIS.  The improved matching is faster (10k pinched cylinder: 1.95 vs 2.26 s per factorisation, medians of 5), but its static pivoting is not backward-stable on
-#: every matrix: the 1/8 soda can at 96 x 96 cells with two collocation points per edge, with its
+#: minimum-degree ordering instead of METIS.  The improved matching is faster (10k pinched
+#: cylinder: 1.95 vs 2.26 s per factorisation, medians of 5), but its static pivoting is not
+#: backward-stable on every matrix: the 1/8 soda can at 96 x 96 cells with two collocation points per edge, with its
 #: nearly dependent support rows re-based into one orthonormal basis (as they then were), perturbs one pivot, counts
 #: 961 negative pivots for 960 constraints and solves to a residual of 1e-3, while another
 #: orthonormal basis of the same rows (what OpenBLAS's LAPACK returns with two threads instead of

@@ -1,8 +1,9 @@
 """A KKT factorisation that is not trusted is redone with PARDISO's robust settings.
 
 PARDISO's symmetric indefinite LDL^T pivots statically (1x1 pivots by default, Bunch-Kaufman 1x1 and
-2x2 pivots inside supernodes in the first fallback, after a weighted matching); on some regular saddle-point matrices its factorisation is not
-backward-stable: it perturbs a pivot, miscounts the inertia, or solves to a residual of 1e-3.
+2x2 pivots inside supernodes in the first fallback, after a weighted matching); on some regular
+saddle-point matrices its factorisation is not backward-stable: it perturbs a pivot, miscounts
+the inertia, or solves to a residual of 1e-3.
 Found on the 1/8 soda can at 96 x 96 cells with two collocation points per edge, whose nearly
 dependent support rows were then re-based into an orthonormal basis by
 ``problem.supports.well_conditioned_rows`` (now they are dropped): with OpenBLAS's LAPACK on two threads that basis
