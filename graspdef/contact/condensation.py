@@ -44,18 +44,24 @@ class ForceControlledAdvance:
         """The advance s* [m] where the barrier force along e of the sample points P (k, 3) with
         weights KW (k,) equals F [N] (F > 0).
 
-        Safeguarded Newton on dB/ds = F from the last solution, over the samples that can reach
-        the barrier within a window |s - s_c| < W around a centre s_c (|d d/d s| <= 1, so the
-        others are inactive and feasible there); the window moves when an iterate leaves it.  The
-        final window is kept (:attr:`window`: its centre and sample indices; the samples outside
-        it are out of the barrier's reach at the solution)."""
+        Safeguarded Newton on G(s) = dB/ds - F from the last solution (usually close to the new
+        one: from a converged advance, one evaluation), over the samples that can reach the
+        barrier within a window |s - s_c| < W around a centre s_c (|d d/d s| <= 1, so the others
+        are inactive and feasible there); the window moves when an iterate leaves it.  Each
+        iterate's sign of G narrows a bracket [lo, hi] of the root; a Newton step that leaves it
+        is replaced by its midpoint, and before the root is bracketed from above an advance never
+        exceeds 0.9 of the smallest gap (the fingertip cannot jump over a sample; with no sample
+        within reach, that is the step itself: sphere tracing).  An infeasible iterate (a sample
+        through the fingertip) counts as G = +inf.  The final window is kept (:attr:`window`: its
+        centre and sample indices; the samples outside it are out of the barrier's reach at the
+        solution)."""
         W = self.reach
         sel = {}
 
         def window(sc):
             d = self._obs.along(P, sc * self._e, self._e)[0]
             idx = np.flatnonzero(d < self._dh + W)
-            sel.update(c=sc, idx=idx, p=P[idx], kw=KW[idx], at=None)
+            sel.update(c=sc, idx=idx, p=P[idx], kw=KW[idx], at=None, dc=float(d.min()) if d.size else np.inf)
 
         def G(t):
             if abs(t - sel["c"]) >= W:
@@ -66,11 +72,12 @@ class ForceControlledAdvance:
 
         def dmin(t):
             """A lower bound of the smallest gap at t: within the window, the window's smallest
-            gap or, if smaller, dhat + W - |t - s_c| (the least gap a sample outside it can have
-            there: it had d >= dhat + W at s_c); elsewhere the smallest gap of all samples."""
+            gap or, if smaller, max(dhat + W, d_c) - |t - s_c| (the least gap a sample outside it
+            can have there: it had d >= dhat + W and d >= d_c, the smallest gap of all samples,
+            at s_c); elsewhere the smallest gap of all samples."""
             off = abs(t - sel["c"])
             if off < W:
-                bound = self._dh + W - off
+                bound = max(self._dh + W, sel["dc"]) - off
                 if len(sel["p"]):
                     at = sel["at"]
                     gap = at[1] if at is not None and at[0] == t else \
@@ -79,53 +86,60 @@ class ForceControlledAdvance:
                 return bound
             return float(self._obs.along(P, t * self._e, self._e)[0].min())
 
-        def bracket(s):
-            """(lo, hi, start): G(lo) < 0 <= G(hi); advancing conservatively (never by more than 0.9
-            of the smallest gap, so the fingertip cannot jump over a sample); ``start`` is the end
-            found last, the one nearer s (where Newton starts: s is the last solution, usually
-            close to the new one)."""
+        def settle(s):
+            """The root from s (None when no feasible advance balances F from there)."""
             window(s)
-            Gs = G(s)[0]
-            step = self._dh
-            if Gs < 0:
-                lo = s
-                for _ in range(200):
-                    dm = dmin(lo)
-                    t = lo + min(step, 0.9 * dm)
-                    if G(t)[0] >= 0:
-                        return lo, t, lo
-                    lo, step = t, 2 * step
-            else:
+            lo, hi = -np.inf, np.inf
+            Gs, gs, ok = G(s)
+            back = self._dh                      # a retreat without a Newton step, doubled each time
+            while not ok:                        # a sample through the fingertip: retreat
                 hi = s
-                for _ in range(60):
-                    t = hi - step
-                    if G(t)[0] < 0:
-                        return t, hi, hi
-                    hi, step = t, 2 * step
-            return None
-
-        br = bracket(self.s) or bracket(0.0)
-        if br is None:
-            raise NoPosition(f"finger contact '{self.name}': no finger position balances {F:.6g} N "
-                             "(a shell point is behind the fingertip)")
-        lo, hi, s = br
-        Gs, gs, ok = G(s)
-        for _ in range(200):                                    # safeguarded Newton
-            if abs(Gs) <= 1e-12 * F or hi - lo <= 1e-15 * max(abs(lo), self._dh):
-                break
-            t = s - Gs / gs if (ok and gs > 0) else np.nan
-            if not (lo < t < hi):
-                t = 0.5 * (lo + hi)
-            Gt, gt, okt = G(t)
-            if Gt < 0:
-                lo = t
-            else:
-                hi = t
-            if okt:
+                s -= max(back, 0.5 * self._dh - sel["at"][1])      # (its gap grows like the retreat)
+                back *= 2
+                if back > 2 ** 60 * self._dh:
+                    return None
+                Gs, gs, ok = G(s)
+            for _ in range(200):
+                if abs(Gs) <= 1e-12 * F:
+                    break
+                if Gs < 0:
+                    lo = s
+                else:
+                    hi = s
+                if hi - lo <= 1e-15 * max(abs(s), self._dh):      # (inf while unbracketed)
+                    break
+                # Newton on log(dB/ds) = log F: the barrier's force grows like a power of the
+                # inverse gap, nearly exponentially in s, which the logarithm makes nearly linear
+                g = Gs + F
+                t = s - np.log(g / F) * g / gs if g > 0 and gs > 0 else np.nan
+                if np.isinf(hi):                 # advancing, the root not yet bounded above
+                    dm = dmin(s)
+                    cap = s + (0.9 * dm if g > 0 or dm < self._dh else dm - 0.5 * self._dh)
+                    if not t < cap:              # (also for t = nan: sphere tracing, or with no
+                        t = cap                  # sample within reach, to half the reach)
+                elif not lo < t < hi:
+                    if np.isfinite(lo):
+                        t = 0.5 * (lo + hi)
+                    else:                        # retreating, the root not yet bounded below
+                        t, back = s - back, 2 * back
+                Gt, gt, okt = G(t)
+                if not okt:
+                    hi = min(hi, t)
+                    continue
                 small = abs(t - s) <= 1e-13 * self._dh
-                s, Gs, gs, ok = t, Gt, gt, okt
+                s, Gs, gs = t, Gt, gt
                 if small:
                     break
+            else:
+                return None
+            return s
+
+        s = settle(self.s)
+        if s is None:
+            s = settle(0.0)
+        if s is None:
+            raise NoPosition(f"finger contact '{self.name}': no finger position balances {F:.6g} N "
+                             "(a shell point is behind the fingertip)")
         self.s = s
         self.window = (sel["c"], sel["idx"]) if abs(s - sel["c"]) < W else None
         return s

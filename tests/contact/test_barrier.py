@@ -138,6 +138,37 @@ def test_the_advance_window_leaves_out_only_inactive_samples(shell, obstacle):
     assert (H_all != H).nnz == 0 and np.array_equal(H_all.indices, H.indices)
 
 
+@pytest.mark.parametrize("obstacle", [_pin(), _pad()], ids=["pin", "pad"])
+def test_the_advance_balances_the_force_from_any_start(shell, obstacle):
+    """The condensed finger advance s* solves dB/ds = F (graspdef.contact.condensation) to 1e-12 F
+    with no sample through the fingertip, whatever the advance it starts from: its own solution
+    (then it only checks it: one evaluation), a fingertip retracted far beyond the barrier's
+    reach, one pushed deep into the shell (infeasible: it must retreat); every start gives the
+    same root (dB/ds is increasing in s, so the root is unique)."""
+    fc = FingerContact(obstacle, (-1.0, 0, 0), 4.0, offset=T / 2).build(shell, shell.evaluator)
+    x = shell.rest_positions + np.random.default_rng(2).normal(size=shell.rest_positions.shape) * 2e-5
+    adv, P, F = fc._cond, fc._ops.points(x), 2.8
+    calls = []
+    derivatives = adv.derivatives
+
+    def counted(*a):
+        calls.append(a[2])
+        return derivatives(*a)
+    adv.derivatives = counted
+    s = fc.advance(x, F)
+    roots = []
+    for start in (s, s - 50 * adv._dh, s + 30 * adv._dh):
+        adv.s = start
+        calls.clear()
+        roots.append(fc.advance(x, F))
+        Bs, Bss, ok, dmin = derivatives(P, fc._kw, roots[-1])
+        assert ok and dmin > 0 and Bss > 0
+        assert abs(Bs - F) <= 1e-12 * F
+        if start == s:
+            assert calls == [s]
+    assert np.ptp(roots) <= 1e-12 * adv._dh
+
+
 def _squeeze(shell, contacts, loads, max_load=1.0, targets=()):
     pr = Problem(shell, list(contacts) + list(loads), [RigidModes()])
     return solve_nonlinear(pr, PathOptions(steps=4, max_load=max_load, targets=targets))
