@@ -33,8 +33,6 @@ from os import PathLike
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import ConvexHull
-from scipy.spatial.transform import Rotation
 
 from graspdef.errors import ProblemError
 from graspdef.geometry import TriMesh, ellipsoid, save_ply
@@ -152,6 +150,7 @@ def hidden_point_removal(points: np.ndarray, camera: np.ndarray, gamma: float = 
     norm = np.linalg.norm(q, axis=1, keepdims=True)
     radius = norm.max() * 10.0**gamma
     flipped = q + 2.0 * (radius - norm) * q / norm
+    from scipy.spatial import ConvexHull      # here: scipy.spatial costs every grasp's start-up 0.06 s
     hull = ConvexHull(np.vstack([flipped, np.zeros((1, 3))]))
     idx = hull.vertices
     return idx[idx < len(points)]
@@ -270,6 +269,7 @@ def scan_surface(mesh: TriMesh, scanner: Scanner = Scanner(), seed: int = 0,
         pts = pts + scanner.sigma * rng.standard_normal((len(pts), 1)) * sight
     pose = np.eye(4)
     if scanner.random_pose:
+        from scipy.spatial.transform import Rotation
         pose[:3, :3] = Rotation.random(random_state=rng).as_matrix()
         direction = rng.standard_normal(3)
         pose[:3, 3] = (direction / np.linalg.norm(direction) * scanner.max_translation

@@ -35,12 +35,21 @@ _COEFFS = np.array([
 ], dtype=float) / 12.0
 
 
-def _powers(x: np.ndarray, k: np.ndarray) -> np.ndarray:
-    """x**k with 0**negative -> 0 (used for derivative monomials)."""
-    out = np.zeros(np.broadcast(x, k).shape)
-    ok = k >= 0
-    out[..., :] = np.where(ok, np.power(x, np.maximum(k, 0)), 0.0)
-    return out
+def _derivative_monomials(da: int, db: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """d^(da+db)/dv^da dw^db of the monomials v^a w^b: (factor (15,), exponent of v (15,), of w
+    (15,)), the factor zero and the exponents clipped to 0 where a derivative removes the monomial."""
+    a, b = _MONOMIALS[:, 0], _MONOMIALS[:, 1]
+    fac = np.ones(len(a))
+    for m in range(da):
+        fac = fac * (a - m)
+    for m in range(db):
+        fac = fac * (b - m)
+    return fac, np.maximum(a - da, 0), np.maximum(b - db, 0)
+
+
+#: (factor, v exponent, w exponent) of the value, d/dv, d/dw, d2/dv2, d2/dw2, d2/dvdw monomials
+_DERIVATIVES = [_derivative_monomials(*d) for d in ((0, 0), (1, 0), (0, 1), (2, 0), (0, 2), (1, 1))]
+_EXPONENTS = np.arange(5)
 
 
 def regular_basis(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -58,20 +67,8 @@ def regular_basis(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
     ddN : (..., 12, 3)       d2/dv2, d2/dw2, d2/dvdw
     """
     p = np.asarray(points, dtype=float)
-    v = p[..., 0:1]
-    w = p[..., 1:2]
-    a = _MONOMIALS[:, 0]
-    b = _MONOMIALS[:, 1]
-
-    def mono(da: int, db: int) -> np.ndarray:
-        fac = np.ones(len(a))
-        for m in range(da):
-            fac = fac * (a - m)
-        for m in range(db):
-            fac = fac * (b - m)
-        return fac * _powers(v, a - da) * _powers(w, b - db)       # (..., 15)
-
-    N = mono(0, 0) @ _COEFFS.T
-    dN = np.stack([mono(1, 0) @ _COEFFS.T, mono(0, 1) @ _COEFFS.T], axis=-1)
-    ddN = np.stack([mono(2, 0) @ _COEFFS.T, mono(0, 2) @ _COEFFS.T, mono(1, 1) @ _COEFFS.T], axis=-1)
-    return N, dN, ddN
+    vp = np.power(p[..., 0:1], _EXPONENTS)           # v^0 .. v^4 (..., 5), once for all six
+    wp = np.power(p[..., 1:2], _EXPONENTS)
+    C = _COEFFS.T
+    out = [(fac * vp[..., ia] * wp[..., ib]) @ C for fac, ia, ib in _DERIVATIVES]
+    return out[0], np.stack(out[1:3], axis=-1), np.stack(out[3:], axis=-1)
