@@ -4,13 +4,15 @@ steps (issue 3's speed case).  Prints and saves (JSON) the wall time of each run
 path, per-step Newton iterations -- and their median.
 
     python scripts/bench_nonlinear_speed.py [--subdivisions 5] [--runs 3] [--gas-kpa 80] [--fixed-steps] [--krylov 10]
+                                            [--predictor cubic]
                                             [--ref GIT_REF] [--out out/bench_nonlinear_speed.json]
 
 ``--ref``: also run the OLD code of that git ref (checked out into a temporary worktree), its runs
 interleaved with the NEW code's (the working tree), and print both side by side (one untimed run of
 each tree, at up to 2,562 control vertices, first warms its numba cache).
 
-``--krylov N`` (10 unless given): the path takes inexact Newton steps (PathOptions.krylov = N, off in
+``--predictor cubic|quadratic|linear``: PathOptions.predictor (an OLD tree without that predictor runs
+its default).  ``--krylov N`` (10 unless given): the path takes inexact Newton steps (PathOptions.krylov = N, off in
 the solver's default; code before them ignores it).  ``--krylov 0``: the solver's default path.
 
 subdivisions 5 gives 10,242 control vertices.  The ball holds air (80 kPa gauge by default, a
@@ -46,6 +48,7 @@ from graspdef.shell.model import Shell
 from graspdef.solve.nonlinear import PathOptions, solve_nonlinear
 sub, steps, force, gas, fixed = int(sys.argv[1]), int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4]), sys.argv[5] == "1"
 krylov = int(sys.argv[6]) if len(sys.argv) > 6 else 0
+predictor = sys.argv[7] if len(sys.argv) > 7 else None
 t_imp = time.perf_counter()
 R, t = 0.0325, 0.0025
 m = sphere(R, sub)
@@ -63,6 +66,11 @@ def show(i):
 opts = PathOptions(steps=steps, max_steps=10 * steps, **({"desired_iterations": 1} if fixed else {}),
                    # inexact Newton steps where the code has them (older code: ignored)
                    **({"krylov": krylov} if "krylov" in PathOptions.__dataclass_fields__ else {}))
+if predictor is not None:
+    import dataclasses
+    from graspdef.solve import nonlinear as _nl
+    if predictor in getattr(_nl, "PREDICTORS", ()):        # older code without it: its default
+        opts = dataclasses.replace(opts, predictor=predictor)
 sol = solve_nonlinear(pr, opts, progress=show)
 t_end = time.perf_counter()
 print(json.dumps({"n_control": int(shell.mesh.n_real), "import_s": t_imp - t0, "setup_s": t_setup - t_imp,
@@ -82,7 +90,8 @@ def _run(a, tree: Path) -> dict:
     t0 = time.perf_counter()
     env = {**os.environ, "PYTHONPATH": str(tree)}
     res = subprocess.run([sys.executable, "-c", CHILD, str(a.subdivisions), str(a.steps), str(a.force), str(a.gas_kpa),
-                          "1" if a.fixed_steps else "0", str(a.krylov)], cwd=tree, env=env,
+                          "1" if a.fixed_steps else "0", str(a.krylov)] + ([a.predictor] if a.predictor else []),
+                         cwd=tree, env=env,
                          stdout=subprocess.PIPE, stderr=None if a.verbose else subprocess.DEVNULL, text=True)
     if res.returncode:
         raise SystemExit(f"a run in {tree} failed")
@@ -115,6 +124,8 @@ def main() -> None:
     ap.add_argument("--krylov", type=int, default=10,
                     help="PathOptions.krylov: GMRES iterations of an inexact Newton step before a fresh factorisation "
                          "(0: none, the solver's default; code without the option ignores it)")
+    ap.add_argument("--predictor", default=None, choices=["quadratic", "linear", "cubic"],
+                    help="PathOptions.predictor (default: the solver's; code without the option uses its default)")
     a = ap.parse_args()
     with code_trees(ROOT, a.ref, "bench_nonlinear_") as trees:
         runs: dict[str, list] = {k: [] for k in trees}

@@ -47,7 +47,7 @@ log = logging.getLogger(__name__)
 METHODS = ("load", "arc_length")
 BIFURCATION = ("report", "locate", "switch")
 LIMIT_POINTS = ("jump", "stop")
-PREDICTORS = ("quadratic", "linear")
+PREDICTORS = ("quadratic", "linear", "cubic")
 #: options read by load-controlled paths only (PathSolver._load_control); an arc-length path
 #: refuses them rather than ignore them
 LOAD_CONTROL_ONLY = ("max_step", "jump_ratio", "predictor", "limit_points")
@@ -95,6 +95,34 @@ def fold_estimate(lam1: float, n1: float, lam2: float, n2: float) -> float | Non
         return None
     y1, y2 = n1 ** -2, n2 ** -2
     return lam2 + y2 * (lam2 - lam1) / (y1 - y2)
+
+
+def extrapolate(u: np.ndarray, t: np.ndarray, step: float, u_back: np.ndarray, h: float,
+                t_back: np.ndarray | None = None, kind: str = "quadratic") -> np.ndarray:
+    """The first iterate of a load step from a converged point (u, with the tangent t = du/dlam
+    there) to lam + step, given the previous point u_back at lam - h (and its tangent ``t_back``):
+    the polynomial u(lam + tau h) = u + tau h t + a tau^2 + b tau^3 through them, at tau = step / h.
+
+    "linear": a = b = 0 (the tangent alone); "quadratic": b = 0, a = u_back - u + h t (through
+    u_back); "cubic": the Hermite cubic that also has the tangent t_back at u_back, a = 3 d +
+    h (t_back - t) and b = 2 d + h (t_back - t) with d = u_back - u + h t.  Each is exact on paths
+    that are polynomials of its degree in lam; the extrapolation error of a smooth path is
+    O(step^2), O(step^3) and O(step^4)."""
+    tau = step / h
+    u0 = u + step * t
+    if kind == "linear":
+        return u0
+    d = u_back - u + h * t
+    if kind == "quadratic":
+        return u0 + tau ** 2 * d
+    if t_back is None:
+        raise ValueError("the cubic predictor needs the tangent at the previous point")
+    b = 2 * d + h * (t_back - t)
+    if abs(tau) * float(np.linalg.norm(b)) > float(np.linalg.norm(d)):
+        # the cubic term outgrows the quadratic one: the last two points do not resolve the
+        # path's curvature here (its extrapolation is not converging), so the quadratic
+        return u0 + tau ** 2 * d
+    return u0 + tau ** 2 * (d + b) + tau ** 3 * b
 
 
 @dataclass(frozen=True)
@@ -145,12 +173,20 @@ class PathOptions:
         pinched cylinder, the ball's grasps), up to 0.22 on steps ending next to a limit point;
         0.58 and 0.92 on steps that jumped over one unnoticed.  Not applied to the first step
         nor to the first after a jump (no curvature term to go with them); 0: no check
-    predictor : the first iterate of a load-controlled step -- "quadratic" (the default): the
-        tangent du/dlam plus the curvature of the last step (u(lam) through the last two points
-        with the tangent at the last); "linear": the tangent alone.  Where the contact set
-        changes from step to step (graspdef's finger-contact paths) u(lam) has a kink at each
-        change and the curvature term overshoots: on the tennis ball's pads the linear predictor
-        needs 45 factorisations instead of 54 for the same equilibria (to 1e-10)
+    predictor : the first iterate of a load-controlled step (:func:`extrapolate`) --
+        "quadratic" (the default): the tangent du/dlam plus the curvature of the last step (u(lam)
+        through the last two points with the tangent at the last); "linear": the tangent alone;
+        "cubic": the Hermite cubic through the last two points with the tangents at both, on a
+        plain stretch of the path (not towards a limit point nor past a jumped one) and where its
+        cubic term is smaller than its quadratic one, else the quadratic.  Measured against
+        "quadratic" (factorisations of the path, 2026-11-28): fewer on smooth paths -- the 10k
+        ball's pinch 19 against 22 (8 path points against 10; 12.5 against 14.6 s), the 32-ring
+        hemisphere (benchmarks/nonlinear) 124 against 151, the slit annular plate 224 against 285
+        -- but more through the snaps of the full pinched cylinder (192 x 96: 292 against 273, two
+        failed steps of 24 factorisations each in both), so not the default.  Where the contact set changes from step to step (graspdef's
+        finger-contact paths) u(lam) has a kink at each change and the curvature term overshoots:
+        on the tennis ball's pads the linear predictor needs 45 factorisations instead of 54 for
+        the same equilibria (to 1e-10)
     limit_points : what load control does where its steps stall (halved below ``min_step``) at
         a limit point of the load -- "jump" (the default): snap, as the loaded structure does,
         to the equilibrium that the smallest jumping step reached (or, if every attempt failed,
@@ -766,11 +802,13 @@ class PathSolver:
         softening = False               # increments limited since the last plain step (a limit point ahead?)
         plain = True                    # no failure and no limited increment since the last point
         t_new = None                    # the tangent du/dlam at the current point, when solved
+        t_back = None
         t_last = None                   # (load factor, |du/dlam|) at the previous converged point
         near = abs(dlam0) * 2.0 ** -opt.refine_critical   # a limit point's bracket is narrow enough
         sgn = float(np.sign(lam_end))
         while len(sol.path) <= opt.max_steps:
             t_here = None                                     # |du/dlam| at the current point
+            t_cur = None
             lc = None                                         # the load of a limit point ahead, estimated
             nxt = next(s for s in stops if (s - lam) * sgn > 1e-12 * abs(lam_end))
             step = dlam if abs(dlam) < abs(nxt - lam) * (1 + 1e-9) else nxt - lam
@@ -783,13 +821,16 @@ class PathSolver:
                 t = t_new if factored and t_new is not None else (
                     self.eq.solve(q, self.eq.g) if factored else self._tangent(u, lam))
                 factored = True
+                t_cur = t
                 t_here = float(np.linalg.norm(t))
                 u0 = u + step * t
-                if back is not None:                          # + the curvature of the last step
+                if back is not None:                          # + the curvature of the last step(s)
                     h = lam - back[1]
-                    # (the step's jump check, below, needs the last step, whatever the predictor)
-                    bend = back[0] - u + h * t if opt.predictor == "quadratic" else np.zeros_like(u)
-                    u0 += (step / h) ** 2 * bend
+                    # (the cubic only on a plain stretch of the path: not towards a limit point nor
+                    # past a jumped one, where the quadratic is the safer extrapolation)
+                    kind = opt.predictor if opt.predictor != "cubic" or (
+                        t_back is not None and not softening and jumped is None) else "quadratic"
+                    u0 = extrapolate(u, t, step, back[0], h, t_back, kind)
                     curved = True
                     # the response softens fast (towards a limit point): the predicted increment
                     # may grow by max_growth at most over the last one, as arc lengths do
@@ -797,7 +838,7 @@ class PathSolver:
                     if pred > opt.max_growth * last > 0 and abs(step) * opt.max_growth * last / pred >= dmin:
                         step *= opt.max_growth * last / pred
                         lam_new, dlam, softening, capped = lam + step, step, True, True
-                        u0 = u + step * t + (step / h) ** 2 * bend
+                        u0 = extrapolate(u, t, step, back[0], h, t_back, kind)
                     # a limit point ahead: aim the step short of the load where the tangents say
                     # it is (FOLD_SHORT of the way there), not at the halving's guess
                     lc = fold_estimate(*t_last, lam, t_here) if (softening or jumped is not None) and t_last else None
@@ -805,7 +846,7 @@ class PathSolver:
                         aim = sgn * max(FOLD_SHORT * abs(lc - lam), 2 * near)
                         if abs(aim) < abs(step):
                             step, lam_new, dlam = aim, lam + aim, aim
-                            u0 = u + step * t + (step / h) ** 2 * bend
+                            u0 = extrapolate(u, t, step, back[0], h, t_back, kind)
             except SolverError:
                 u0, factored = u.copy(), False
             snapped = None
@@ -885,6 +926,7 @@ class PathSolver:
             self.eq.commit(u_new)
             self._emit(sol, pt)
             back = (u, lam) if snapped is None else None      # no curvature across a jump
+            t_back = t_cur if snapped is None else None
             t_last = (lam, t_here) if snapped is None and t_here is not None else None
             u, lam, q, factored = u_new, lam_new, st.load, snapped is None
             if snapped is not None:

@@ -242,8 +242,8 @@ def test_the_linear_predictor_reaches_the_same_equilibria(shell):
     for lam in (0.25, 0.5, 1.0):
         a, b = (s.at(lam).u for s in sols)
         assert np.abs(a - b).max() <= 1e-6 * np.abs(a).max()
-    with pytest.raises(ProblemError, match="predictor must be one of quadratic, linear"):
-        PathOptions(predictor="cubic")
+    with pytest.raises(ProblemError, match="predictor must be one of quadratic, linear, cubic"):
+        PathOptions(predictor="quartic")
 
 
 def test_sample_operator_gathers_and_scatters_like_the_stencils(shell):
