@@ -87,7 +87,8 @@ class ForceControlledAdvance:
             return float(self._obs.along(P, t * self._e, self._e)[0].min())
 
         def settle(s):
-            """The root from s (None when no feasible advance balances F from there)."""
+            """The root from s, or None when no feasible advance balances F from there (the reason
+            in ``sel["why"]``)."""
             window(s)
             lo, hi = -np.inf, np.inf
             Gs, gs, ok = G(s)
@@ -97,6 +98,7 @@ class ForceControlledAdvance:
                 s -= max(back, 0.5 * self._dh - sel["at"][1])      # (its gap grows like the retreat)
                 back *= 2
                 if back > 2 ** 60 * self._dh:
+                    sel["why"] = "a shell point is behind the fingertip"
                     return None
                 Gs, gs, ok = G(s)
             for _ in range(200):
@@ -131,6 +133,7 @@ class ForceControlledAdvance:
                 if small:
                     break
             else:
+                sel["why"] = f"no convergence in 200 iterations (|dB/ds - F| = {abs(Gs):.3g} N)"
                 return None
             return s
 
@@ -139,7 +142,7 @@ class ForceControlledAdvance:
             s = settle(0.0)
         if s is None:
             raise NoPosition(f"finger contact '{self.name}': no finger position balances {F:.6g} N "
-                             "(a shell point is behind the fingertip)")
+                             f"({sel['why']})")
         self.s = s
         self.window = (sel["c"], sel["idx"]) if abs(s - sel["c"]) < W else None
         return s

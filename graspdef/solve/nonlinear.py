@@ -183,10 +183,10 @@ class PathOptions:
         ball's pinch 19 against 22 (8 path points against 10; 12.5 against 14.6 s), the 32-ring
         hemisphere (benchmarks/nonlinear) 124 against 151, the slit annular plate 224 against 285
         -- but more through the snaps of the full pinched cylinder (192 x 96: 292 against 273, two
-        failed steps of 24 factorisations each in both), so not the default.  Where the contact set changes from step to step (graspdef's
-        finger-contact paths) u(lam) has a kink at each change and the curvature term overshoots:
-        on the tennis ball's pads the linear predictor needs 45 factorisations instead of 54 for
-        the same equilibria (to 1e-10)
+        failed steps of 24 factorisations each in both), so not the default.  Where the contact
+        set changes from step to step (graspdef's finger-contact paths) u(lam) has a kink at each
+        change and the curvature term overshoots: on the tennis ball's pads the linear predictor
+        needs 45 factorisations instead of 54 for the same equilibria (to 1e-10)
     limit_points : what load control does where its steps stall (halved below ``min_step``) at
         a limit point of the load -- "jump" (the default): snap, as the loaded structure does,
         to the equilibrium that the smallest jumping step reached (or, if every attempt failed,
@@ -802,13 +802,13 @@ class PathSolver:
         softening = False               # increments limited since the last plain step (a limit point ahead?)
         plain = True                    # no failure and no limited increment since the last point
         t_new = None                    # the tangent du/dlam at the current point, when solved
-        t_back = None
+        t_back = None                   # the tangent at the previous converged point (the cubic predictor)
         t_last = None                   # (load factor, |du/dlam|) at the previous converged point
         near = abs(dlam0) * 2.0 ** -opt.refine_critical   # a limit point's bracket is narrow enough
         sgn = float(np.sign(lam_end))
         while len(sol.path) <= opt.max_steps:
             t_here = None                                     # |du/dlam| at the current point
-            t_cur = None
+            t_cur = None                                      # the tangent at the current point, when solved
             lc = None                                         # the load of a limit point ahead, estimated
             nxt = next(s for s in stops if (s - lam) * sgn > 1e-12 * abs(lam_end))
             step = dlam if abs(dlam) < abs(nxt - lam) * (1 + 1e-9) else nxt - lam
