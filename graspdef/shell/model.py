@@ -15,6 +15,10 @@ from .kinematics import fundamental_forms, normal
 from .materials import LinearElastic
 
 
+#: how many keys :meth:`Shell.derived` keeps per shell
+DERIVED_KEPT = 8
+
+
 def surface_derivatives(stencils: np.ndarray, dN: np.ndarray, ddN: np.ndarray, x: np.ndarray) -> np.ndarray:
     """y = (a1, a2, a11, a22, a12) at quadrature points, (n_faces, n_quad, 5, 3)."""
     X = x[stencils]                                              # (f, S, 3)
@@ -107,6 +111,22 @@ class Shell:
         from .energy import BlockPattern
 
         return BlockPattern(self)
+
+    def derived(self, key, make):
+        """``make()``, computed once per hashable ``key`` and kept with this immutable shell: set-up
+        data that several terms derive from the shell alike (a fingertip's contact samples, read by
+        its barrier, its friction and its report).  ``make`` must depend on nothing but the shell and
+        what ``key`` names.  The last :data:`DERIVED_KEPT` keys are kept (a sweep over grasp
+        positions on one shell does not accumulate them)."""
+        kept = self.__dict__.setdefault("_derived", {})
+        if key in kept:
+            kept[key] = kept.pop(key)                   # most recently used last
+            return kept[key]
+        value = make()
+        kept[key] = value
+        while len(kept) > DERIVED_KEPT:
+            kept.pop(next(iter(kept)))
+        return value
 
     @functools.cached_property
     def face_schedules(self) -> tuple:

@@ -729,7 +729,8 @@ class PathSolver:
         sol = NonlinearSolution(self.problem, opt)
         n = self.eq.n
         u = np.zeros(n)
-        st0 = self.eq.evaluate(u, 0.0, 2)
+        # with a gas the start is Newton's first iterate (its Hessian is evaluated there): no Hessian here
+        st0 = self.eq.evaluate(u, 0.0, 1 if self.gas else 2)
         self.q_norm = float(np.linalg.norm(st0.load))
         if self.q_norm == 0 and not np.any(self.eq.g) and not self.gas:
             raise ProblemError("the problem has no load: add loads, a prescribed displacement or an enclosed gas")

@@ -277,3 +277,29 @@ def test_duck_held_at_the_papers_force(mu, held):
     the 27.3 g duck's weight (scenes/duck), so it is held -- its contact forces' vertical parts carry m g (5 %) and each
     finger's friction stays inside its cone; with mu = 0 it slips out (one line)."""
     _grasp_held_or_slips("duck", 19.22, mu, held)
+
+
+def test_a_fingers_terms_share_one_sample_set_and_the_sets_are_bounded(shell):
+    """A fingertip's barrier and its friction term are built from one sample set, made once per
+    shell (Shell.derived; the samples are read-only, since every term built from them holds
+    them), while another fingertip gets its own; the shell keeps at most DERIVED_KEPT such sets
+    however many fingertip positions a sweep tries."""
+    from graspdef.shell.model import DERIVED_KEPT
+
+    m = icosphere(radius=R, subdivisions=2)
+    sh = Shell(m.vertices, m.faces, LinearElastic(1e6, 0.45), T)
+    spec = _finger(1.0, 5.0, "right")
+    b = spec.build(sh, sh.evaluator)
+    f = FingerFriction(spec, 0.5).build(sh, sh.evaluator)
+    assert f.contact is spec and b.sample_operator is f._fc.sample_operator
+    st, N, w = b.samples
+    assert not (st.flags.writeable or N.flags.writeable or w.flags.writeable)
+    other = _finger(-1.0, 5.0, "left").build(sh, sh.evaluator)
+    assert other.sample_operator is not b.sample_operator
+    # a fresh shell of the same mesh: the same numbers, made anew
+    sh2 = Shell(m.vertices, m.faces, LinearElastic(1e6, 0.45), T)
+    again = spec.build(sh2, sh2.evaluator)
+    assert again.sample_operator is not b.sample_operator and np.array_equal(again.samples[2], w)
+    for k in range(DERIVED_KEPT + 3):
+        FingerContact(_pad(1.0, h=0.004 + 1e-4 * k), (-1.0, 0.0, 0.0), 5.0, offset=T / 2).build(sh, sh.evaluator)
+    assert len(sh.__dict__["_derived"]) == DERIVED_KEPT
