@@ -84,6 +84,22 @@ def _new_pardiso(mtype: int):
     return pypardiso.PyPardisoSolver(mtype=mtype)
 
 
+def _cnr_threads(solver) -> int:
+    """PARDISO's conditional numerical reproducibility (iparm 34 > 0: the number of OpenMP threads
+    its factorisation uses, here MKL's own count): the same matrix then gives the same factor to the
+    bit in every call and every process on this machine.  Without it the parallel factorisation is
+    not reproducible: on 2 cores, one 10k-ball tangent factorised 6 times gave two different
+    factors at random (single and double precision alike), and a path through snaps (the 192 x 96
+    pinched cylinder) took 230 and 519 factorisations in two runs of the same code.  Cost measured
+    2026-11-28 on that tangent (30,732 unknowns): 0.207 -> 0.229 s single, 0.296 -> 0.312 s double
+    per factorisation, and the sequential ordering it needs (iparm 2 = 2) 0.67 -> 0.79 s once per
+    sparsity pattern."""
+    try:
+        return max(1, int(solver.libmkl.MKL_Get_Max_Threads()))
+    except (AttributeError, OSError):             # an MKL without the service function: one thread
+        return 1
+
+
 def constraint_scale(K: sp.spmatrix) -> float:
     """Scale of C in the KKT matrix: the mean |diagonal| of K (balances the two blocks)."""
     d = np.abs(K.diagonal())
@@ -295,7 +311,8 @@ class KKTSystem:
             ooc = {60: 2} if self.backend == "pardiso-ooc" else {}
             if ooc and self._ooc_dir is None:
                 self._ooc_dir = ooc_folder()
-            for k, v in {**_PARDISO_IPARM, **self._variant_iparm(), **ooc, 28: int(self.single)}.items():
+            for k, v in {**_PARDISO_IPARM, **self._variant_iparm(), **ooc, 28: int(self.single),
+                         34: _cnr_threads(solver)}.items():
                 self._solver.set_iparm(k, v)
         s = self._solver
         self._U = U
@@ -850,7 +867,8 @@ def _available_mb() -> int | None:
 #: PARDISO settings (1-based iparm): see the README's solver section
 _PARDISO_IPARM = {
     1: 1,       # use the values below, not the defaults
-    2: 3,       # parallel METIS nested-dissection ordering
+    2: 2,       # METIS nested-dissection ordering, the sequential one: the parallel one (3)
+                # rules out PARDISO's reproducible mode (iparm 34, set per solver: _cnr_threads)
     8: 0,       # no automatic iterative refinement: KKTSystem.solve refines while the residual in
                 # the unperturbed system is too large (PARDISO's two automatic steps tripled the
                 # cost of every Newton back-substitution at 10k: 0.12 s vs 0.04 s)
