@@ -86,14 +86,16 @@ def _new_pardiso(mtype: int):
 
 def _cnr_threads(solver) -> int:
     """PARDISO's conditional numerical reproducibility (iparm 34 > 0: the number of OpenMP threads
-    its factorisation uses, here MKL's own count): the same matrix then gives the same factor to the
-    bit in every call and every process on this machine.  Without it the parallel factorisation is
-    not reproducible: on 2 cores, one 10k-ball tangent factorised 6 times gave two different
-    factors at random (single and double precision alike), and a path through snaps (the 192 x 96
-    pinched cylinder) took 230 and 519 factorisations in two runs of the same code.  Cost measured
-    2026-11-28 on that tangent (30,732 unknowns): 0.207 -> 0.229 s single, 0.296 -> 0.312 s double
-    per factorisation, and the sequential ordering it needs (iparm 2 = 2) 0.67 -> 0.79 s once per
-    sparsity pattern."""
+    its factorisation uses, here MKL's own count): the same matrix then gives the same factor and
+    the same solutions to the bit in every call and every process with that thread count.  Without
+    it neither the parallel factorisation nor the parallel back-substitution is reproducible: on 2
+    cores one 10k-ball tangent factorised 6 times gave two different factors at random (single and
+    double precision alike), 10 back-substitutions with one factor two different solutions, and a
+    path through snaps (the 192 x 96 pinched cylinder) took 230 and 519 factorisations in two runs
+    of the same code.  Cost measured 2026-11-28 on that tangent (30,732 unknowns): a factorisation
+    0.207 -> 0.229 s single, 0.296 -> 0.312 s double; a back-substitution 5.0 -> 10.7 ms (it runs on
+    one thread; PARDISO's parallel-solve settings, iparm 25, change nothing); the sequential ordering
+    that the mode needs (iparm 2 = 2) 0.67 -> 0.79 s once per sparsity pattern."""
     try:
         return max(1, int(solver.libmkl.MKL_Get_Max_Threads()))
     except (AttributeError, OSError):             # an MKL without the service function: one thread
