@@ -79,6 +79,8 @@ print(json.dumps({"n_control": int(shell.mesh.n_real), "import_s": t_imp - t0, "
                   # counters the code before inexact Newton steps did not keep: None there
                   "hessians": getattr(sol, "n_hessians", None),
                   "back_substitutions": getattr(sol, "n_back_substitutions", None),
+                  # calls (a block of right-hand sides is one call); code before blocks: each was one
+                  "back_calls": getattr(sol, "n_back_calls", getattr(sol, "n_back_substitutions", None)),
                   "inexact_steps": getattr(sol, "n_inexact", None), "gmres_iterations": getattr(sol, "n_krylov", None),
                   "factor_s": sol.timings["factor"], "solve_s": sol.timings["solve"],
                   "top_displacement_mm": float(-sol.probe("top")[2] * 1e3),
@@ -104,7 +106,7 @@ def _show(label: str, k: int, r: dict) -> None:
     print(f"{label} run {k + 1}: {r['n_control']} control vertices, path {r['path_s']:.1f} s (set-up {r['setup_s']:.1f} s, "
           f"factor {r['factor_s']:.1f} s, {r['factorisations']} factorisations), {r['steps']} steps, "
           f"Newton iterations {r['newton_iterations']}, "
-          + (f"{r['hessians']} Hessians, {r['back_substitutions']} back-substitutions, {r['inexact_steps']} inexact "
+          + (f"{r['hessians']} Hessians, {r['back_substitutions']} back-substitutions in {r.get('back_calls')} calls, {r['inexact_steps']} inexact "
              f"Newton steps ({r['gmres_iterations']} GMRES iterations), " if r.get("hessians") is not None else "")
           + f"pole displacement {r['top_displacement_mm']:.2f} mm", flush=True)
 

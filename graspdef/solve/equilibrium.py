@@ -199,17 +199,29 @@ class Equilibrium:
         from equilibrium), so a single-precision factor's is neither certified nor returned (None)."""
         self.kkt.factor(state.hessian)
         self._lowrank = None
-        if inertia or not self.kkt.single:
-            self.kkt.certify_inertia()              # a single factor's inertia, or a double factor
-            neg = self.kkt.negative_pivots(self.m)  # an unexpected inertia is checked once robustly
-        else:
-            neg = None
+        V = c = start = None
         if state.rank_one:
             V = np.stack([v for _, v in state.rank_one], axis=1)             # (n, k)
             c = np.array([c for c, _ in state.rank_one])
-            W, _, _ = self.kkt.solve(V, exact=False)                          # A^-1 [V; 0]
-            S = np.diag(1.0 / c) + V.T @ W                                    # C^-1 + V^T A^-1 V
-            self._lowrank = (V, W, S)
+        deferred = not (inertia or not self.kkt.single)
+        if not deferred:
+            # a single factor's inertia, or a double factor; the Woodbury vectors' first
+            # refinement steps ride in the certificate's back-substitutions
+            made = self.kkt.n_factor
+            _, start = self.kkt.certify_inertia_along(V)
+            neg = self.kkt.negative_pivots(self.m)  # an unexpected inertia is checked once robustly
+            if self.kkt.n_factor != made:           # refactorised: the iterates are another factor's
+                start = None
+        else:
+            neg = None
+        if V is not None:
+            if deferred:
+                # no inertia asked of a single factor: W = A^-1 [V; 0] is solved with the next
+                # solve's right-hand sides, in the same back-substitutions (:meth:`solve`)
+                self._lowrank = (V, None, c)
+                return None
+            self._lowrank = self._woodbury(V, c, self.kkt.solve(V, exact=False, start=start)[0])
+            S = self._lowrank[2]
             if neg is not None:
                 # Haynsworth: neg(A + V C V^T) = neg(A) + neg(-S) - neg(-C^-1); negative c
                 # (e.g. a force-controlled contact's condensed DOF) adds no negative pivot
@@ -224,8 +236,38 @@ class Equilibrium:
         factor's solve stops refining once its relative residual is ``rtol`` -- what a double
         factor's solve is accepted at, and all that a path's predictors and Newton steps need --
         unless ``exact`` (then it goes on to a double solve's backward error,
-        :meth:`graspdef.solve.sparse.KKTSystem.solve`); a double factor's solve is the same either way."""
-        du, _, _ = self.kkt.solve(rhs, g, rtol=rtol, exact=exact)
+        :meth:`graspdef.solve.sparse.KKTSystem.solve`); a double factor's solve is the same either way.
+
+        With a single-precision factor, several right-hand sides -- and the Woodbury vectors W =
+        A^-1 [V; 0] still due from a :meth:`factor` that gave no inertia -- are solved as one
+        block, each column scaled to unit norm and refined to ``rtol`` (the vectors to the tighter of
+        ``rtol`` and the 1e-8 they need): a block
+        costs the back-substitutions of one column (graspdef.solve.sparse.KKTSystem.certify_inertia)."""
+        pending = self._lowrank is not None and self._lowrank[1] is None
+        R = np.asarray(rhs, float)
+        if self.kkt.single and (pending or R.ndim == 2 and R.shape[1] > 1):
+            R2 = R.reshape(self.n, -1)
+            G2 = np.zeros((self.m, R2.shape[1])) if g is None else np.asarray(g, float).reshape(self.m, -1)
+            cols, gcols = [R2], [G2]
+            if pending:
+                V = self._lowrank[0]
+                cols.insert(0, V)
+                gcols.insert(0, np.zeros((self.m, V.shape[1])))
+            B, G = np.column_stack(cols), np.column_stack(gcols)
+            sc = np.sqrt(np.linalg.norm(B, axis=0) ** 2 + np.linalg.norm(G, axis=0) ** 2)
+            sc[~(sc > 0)] = 1.0
+            # the block's residual test is on all its columns: rtol / sqrt(k) holds each to rtol
+            tol = (min(rtol, 1e-8) if pending else rtol) / np.sqrt(B.shape[1])
+            X, _, _ = self.kkt.solve(B / sc, G / sc, rtol=tol, exact=exact)
+            X = X * sc
+            if pending:
+                V, _, c = self._lowrank
+                k = V.shape[1]
+                self._lowrank = self._woodbury(V, c, X[:, :k])
+                X = X[:, k:]
+            du = X.reshape(R.shape)
+        else:
+            du, _, _ = self.kkt.solve(rhs, g, rtol=rtol, exact=exact)
         if self._lowrank is not None:
             V, W, S = self._lowrank
             du = du - W @ np.linalg.solve(S, V.T @ du)
@@ -239,10 +281,18 @@ class Equilibrium:
             raise SolverError("the tangent solve produced non-finite values")
         return du
 
+    @staticmethod
+    def _woodbury(V: np.ndarray, c: np.ndarray, W: np.ndarray) -> tuple:
+        """(V, W, S) of the Woodbury identity for A + V diag(c) V^T, W = A^-1 [V; 0]."""
+        return V, W, np.diag(1.0 / c) + V.T @ W                           # C^-1 + V^T A^-1 V
+
     def precondition(self, r: np.ndarray) -> np.ndarray:
         """The displacement part of the last factorisation's inverse applied to [r; 0] (one raw
         back-substitution, the rank-one parts by Woodbury): it maps into the null space of C and
         ignores the range of C^T."""
+        if self._lowrank is not None and self._lowrank[1] is None:
+            V, _, c = self._lowrank
+            self._lowrank = self._woodbury(V, c, self.kkt.solve(V, exact=False)[0])
         du = self.kkt.back(r)
         if self._lowrank is not None:
             V, W, S = self._lowrank

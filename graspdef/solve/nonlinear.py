@@ -321,6 +321,8 @@ class NonlinearSolution(DisplacementField):
         ``extra["converged_by"]`` the path says why every step stopped where it did
     timings : seconds;  n_factorisations : tangent factorisations;  n_hessians : Hessian
         evaluations;  n_back_substitutions : back-substitutions (each right-hand side);
+        n_back_calls : back-substitution calls (a block of right-hand sides in one call costs about
+        what one column does, graspdef.solve.sparse.KKTSystem.certify_inertia_along);
         n_krylov : GMRES iterations of inexact Newton steps;  n_inexact : inexact Newton steps;
         n_single : of the factorisations, single-precision ones (``precision`` "mixed", or "auto"
         from 20,000 unknowns; the rest double);  n_certificates : inertias of single-precision
@@ -338,6 +340,7 @@ class NonlinearSolution(DisplacementField):
     n_factorisations: int = 0
     n_hessians: int = 0
     n_back_substitutions: int = 0
+    n_back_calls: int = 0
     n_krylov: int = 0
     n_inexact: int = 0
     n_single: int = 0
@@ -423,6 +426,7 @@ class PathSolver:
         self.switched = False             # a branch switch has been made (one per path)
         self.n_inexact = 0                # inexact (GMRES) Newton steps taken
         self.jumps: list[dict] = []       # limit points passed by a jump (load control)
+        self._ahead = None                # (factorisation count, load, du/dlam) solved with a Newton step
 
     # ---------------------------------------------------------------------------------------
     def _record(self, u, lam, state, its, inst, kind="step") -> PathPoint:
@@ -549,6 +553,13 @@ class PathSolver:
             gn = max(float(np.linalg.norm(st.gradient)), 1e-300)
             eta_n = NEWTON_FORCING * min(rel, 0.1) if fresh else STALE_FORCING
             rtol = max(1e-8, eta_n * self.residual_norm / gn)
+            if fresh and near is not None:
+                # the factorisation that gives the stability is, once converged, the next step's
+                # predictor: its tangent du/dlam = A^-1 q rides in this step's back-substitutions
+                # (:meth:`_load_tangent`)
+                both = eq.solve(np.stack([-st.gradient, st.load], 1), np.stack([cres, eq.g], 1), exact=False)
+                self._ahead = (eq.n_factorisations, st.load.copy(), both[:, 1])
+                return both[:, 0]
             return eq.solve(-st.gradient, cres, rtol=min(rtol, 0.1), exact=False)
 
         def refresh(u, st, cres, tight=False, keep_near=False):
@@ -678,6 +689,15 @@ class PathSolver:
         lim = self.opt.max_probe_displacement
         return lim is not None and any(float(np.linalg.norm(v)) >= lim for v in pt.probes.values())
 
+    def _load_tangent(self, st):
+        """du/dlam = A^-1 q at a converged state on the last factorisation: the one solved along
+        with the Newton step on it (``newton``'s direction) if that was this factorisation and
+        this load (to the bit), else a solve now."""
+        a, self._ahead = self._ahead, None
+        if a is not None and a[0] == self.eq.n_factorisations and np.array_equal(a[1], st.load):
+            return a[2]
+        return self.eq.solve(st.load, self.eq.g)
+
     def _tangent(self, u, lam):
         st = self.eq.evaluate(u, lam, 2)
         self.eq.factor(st, inertia=False)
@@ -771,6 +791,7 @@ class PathSolver:
         sol.n_factorisations = self.eq.n_factorisations
         sol.n_hessians = self.eq.n_hessians
         sol.n_back_substitutions = self.eq.kkt.n_back
+        sol.n_back_calls = self.eq.kkt.n_back_calls
         sol.n_single = self.eq.kkt.n_single
         sol.n_certificates = self.eq.kkt.certificates
         sol.n_krylov = self.eq.n_krylov
@@ -862,7 +883,7 @@ class PathSolver:
                 # the tangent du/dlam at the new point (its factorisation is at hand: the next
                 # step's predictor), and the step's consistency with the two tangents
                 try:
-                    t_new = self.eq.solve(st.load, self.eq.g)
+                    t_new = self._load_tangent(st)
                 except SolverError:
                     t_new = None
                 ratio = None
