@@ -464,9 +464,16 @@ class KKTSystem:
         return False, None
 
     def _apply(self, x: np.ndarray) -> np.ndarray:
-        """The (scaled) KKT matrix of the last factorisation times x, in double."""
+        """The (scaled) KKT matrix of the last factorisation times x (one column or a block), in double."""
         n, s = self.n, self.scale
-        return np.concatenate([self.K @ x[:n] + s * (self.C.T @ x[n:]), s * (self.C @ x[:n])])
+        if x.ndim == 2 and 1 < x.shape[1] <= 3:
+            # SciPy's several-column product (csr_matvecs) took 6.0 ms for two columns of the 10k
+            # ball's K (3.4 M entries) where two one-column products take 3.6 (and 6.3 against 5.4
+            # for three); the same sums in the same order either way
+            Kx = np.column_stack([self.K @ x[:n, j] for j in range(x.shape[1])])
+        else:
+            Kx = self.K @ x[:n]
+        return np.concatenate([Kx + s * (self.C.T @ x[n:]), s * (self.C @ x[:n])])
 
     def retry_robust(self) -> bool:
         """Refactor the last matrix with the next PARDISO settings not yet tried on it -- the
