@@ -203,7 +203,7 @@ class Equilibrium:
         if state.rank_one:
             V = np.stack([v for _, v in state.rank_one], axis=1)             # (n, k)
             c = np.array([c for c, _ in state.rank_one])
-        deferred = not (inertia or not self.kkt.single)
+        deferred = self.kkt.single and not inertia
         if not deferred:
             # a single factor's inertia, or a double factor; the Woodbury vectors' first
             # refinement steps ride in the certificate's back-substitutions
@@ -245,7 +245,7 @@ class Equilibrium:
         costs the back-substitutions of one column (graspdef.solve.sparse.KKTSystem.certify_inertia)."""
         pending = self._lowrank is not None and self._lowrank[1] is None
         R = np.asarray(rhs, float)
-        if self.kkt.single and (pending or R.ndim == 2 and R.shape[1] > 1):
+        if pending or self.kkt.single and R.ndim == 2 and R.shape[1] > 1:
             R2 = R.reshape(self.n, -1)
             G2 = np.zeros((self.m, R2.shape[1])) if g is None else np.asarray(g, float).reshape(self.m, -1)
             cols, gcols = [R2], [G2]
