@@ -238,34 +238,20 @@ class Equilibrium:
         unless ``exact`` (then it goes on to a double solve's backward error,
         :meth:`graspdef.solve.sparse.KKTSystem.solve`); a double factor's solve is the same either way.
 
-        With a single-precision factor, several right-hand sides -- and the Woodbury vectors W =
-        A^-1 [V; 0] still due from a :meth:`factor` that gave no inertia -- are solved as one
-        block, each column scaled to unit norm and refined to ``rtol`` (the vectors to the tighter of
-        ``rtol`` and the 1e-8 they need): a block
-        costs the back-substitutions of one column (graspdef.solve.sparse.KKTSystem.certify_inertia)."""
-        pending = self._lowrank is not None and self._lowrank[1] is None
-        R = np.asarray(rhs, float)
-        if pending or self.kkt.single and R.ndim == 2 and R.shape[1] > 1:
-            R2 = R.reshape(self.n, -1)
-            G2 = np.zeros((self.m, R2.shape[1])) if g is None else np.asarray(g, float).reshape(self.m, -1)
-            cols, gcols = [R2], [G2]
-            if pending:
-                V = self._lowrank[0]
-                cols.insert(0, V)
-                gcols.insert(0, np.zeros((self.m, V.shape[1])))
-            B, G = np.column_stack(cols), np.column_stack(gcols)
-            sc = np.sqrt(np.linalg.norm(B, axis=0) ** 2 + np.linalg.norm(G, axis=0) ** 2)
-            sc[~(sc > 0)] = 1.0
-            # the block's residual test is on all its columns: rtol / sqrt(k) holds each to rtol
-            tol = (min(rtol, 1e-8) if pending else rtol) / np.sqrt(B.shape[1])
-            X, _, _ = self.kkt.solve(B / sc, G / sc, rtol=tol, exact=exact)
-            X = X * sc
-            if pending:
-                V, _, c = self._lowrank
-                k = V.shape[1]
-                self._lowrank = self._woodbury(V, c, X[:, :k])
-                X = X[:, k:]
-            du = X.reshape(R.shape)
+        The Woodbury vectors W = A^-1 [V; 0] still due from a :meth:`factor` that gave no inertia
+        are solved with ``rhs`` as one block (each column refined to its own tolerance, the vectors
+        to the tighter of ``rtol`` and the 1e-8 they need): a block costs the back-substitutions of
+        one column (graspdef.solve.sparse.KKTSystem.certify_inertia_along)."""
+        if self._lowrank is not None and self._lowrank[1] is None:
+            V, _, c = self._lowrank
+            k = V.shape[1]
+            R = np.asarray(rhs, float)
+            G = np.zeros((self.m,) + R.shape[1:]) if g is None else np.asarray(g, float).reshape((self.m,) + R.shape[1:])
+            X, _, _ = self.kkt.solve(np.column_stack([V, R.reshape(self.n, -1)]),
+                                     np.column_stack([np.zeros((self.m, k)), G.reshape(self.m, -1)]),
+                                     rtol=min(rtol, 1e-8), exact=exact)
+            self._lowrank = self._woodbury(V, c, X[:, :k])
+            du = X[:, k:].reshape(R.shape)
         else:
             du, _, _ = self.kkt.solve(rhs, g, rtol=rtol, exact=exact)
         if self._lowrank is not None:

@@ -609,7 +609,8 @@ class KKTSystem:
               start: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, float]:
         """Solve K u + C^T l = f, C u = g for one (n,) or several (n, k) right-hand sides.
 
-        Returns (u, l, relative residual |r| / |rhs|).  The solution is refined (at most
+        Returns (u, l, relative residual |r| / |rhs|, the largest over the columns: each column is
+        its own solve).  The solution is refined (at most
         ``refinements`` back-substitutions of the residual) and accepted when its relative residual
         is at most ``rtol`` **or** its normwise backward error (:func:`backward_error`) is at most
         :data:`BACKWARD_TOL` and the system does not amplify the right-hand side by more than
@@ -635,7 +636,14 @@ class KKTSystem:
         def residual(x):
             return apply(x) - rhs
 
-        bn = max(float(np.linalg.norm(rhs)), 1e-300)
+        # each column of several right-hand sides is its own solve: its residual relative to its
+        # own right-hand side (as the backward error is each column's), not the block's norm, which
+        # a column of larger size would dominate
+        bn = np.maximum(np.linalg.norm(rhs.reshape(rhs.shape[0], -1), axis=0), 1e-300)
+
+        def relative(r):
+            return float((np.linalg.norm(r.reshape(r.shape[0], -1), axis=0) / bn).max())
+
         sol = self._back(rhs) if start is None else np.asarray(start, float).reshape(rhs.shape)
         res = residual(sol)
         eta = backward_error(self.norm, sol, res, rhs)
@@ -644,7 +652,7 @@ class KKTSystem:
         for _ in range(MIXED_REFINEMENTS if single else refinements):
             if not np.all(np.isfinite(sol)) or eta <= (MIXED_FLOOR if single else 0.01 * BACKWARD_TOL):
                 break
-            if (not single or loose) and np.linalg.norm(res) <= (1.0 if loose else 0.01) * rtol * bn:
+            if (not single or loose) and relative(res) <= (1.0 if loose else 0.01) * rtol:
                 break
             new = sol - self._back(res)
             new_res = residual(new)
@@ -655,13 +663,13 @@ class KKTSystem:
             sol, res, eta = new, new_res, new_eta
             if single and slow:                         # a single factor's refinement at its limit
                 break
-        met = loose and bool(np.all(np.isfinite(sol))) and float(np.linalg.norm(res)) <= rtol * bn
+        met = loose and bool(np.all(np.isfinite(sol))) and relative(res) <= rtol
         if single and not met and eta > MIXED_BACKWARD_TOL and np.all(np.isfinite(sol)):
             sol, res, eta = self._gmres_refine(apply, rhs, sol, res, eta)
         self.seconds_solve += time.perf_counter() - t0
         finite = bool(np.all(np.isfinite(sol)))
         if finite:
-            rel = float(np.linalg.norm(res) / bn)
+            rel = relative(res)
             amp = self.norm * float(np.abs(sol).max()) / max(float(np.abs(rhs).max()), 1e-300)
         failed = not finite or rel > rtol and not (eta <= BACKWARD_TOL and amp <= MAX_AMPLIFICATION)
         if (failed or single and eta > MIXED_BACKWARD_TOL and not met) and self.retry_robust():

@@ -139,3 +139,24 @@ def test_the_predictor_tangent_rides_with_the_last_newton_step():
     assert sol.completed and sol.n_single == sol.n_factorisations
     assert len(points) == len(sol.path) - 1 and max(points) <= 1e-7
     assert sum(used) >= len(used) // 2 + 1
+
+
+def test_each_column_of_a_block_is_solved_to_its_own_tolerance():
+    """A loose single-precision solve (rtol 1e-6) of two right-hand sides: one of size 1 along the
+    stiffest directions, one of size 1e-4 along the softest (eigenvalues 1 to 1e6): each column's
+    KKT residual relative to its own right-hand side is at most rtol.  (A test on the block's norm, which the large column
+    dominates, stopped with the small one's at 1.7e-4.)"""
+    n = 150
+    K = _spd_with(np.logspace(0, 6, n), 7)
+    C = np.eye(1, n)
+    _, Q = np.linalg.eigh(K)
+    b_big = Q[:, -5:] @ np.ones(5)                 # the stiff directions: a raw solve is accurate there
+    b_small = 1e-4 * (Q[:, :5] @ np.ones(5))       # the soft ones: float32's error times 1e6
+    with S.KKTSystem(sp.csr_matrix(C), "pardiso", "mixed") as kkt:
+        kkt.factor(sp.csr_matrix(K))
+        U, L, rel = kkt.solve(np.stack([b_big, b_small], 1), rtol=1e-6, exact=False)
+    worst = 0.0
+    for j, b in enumerate((b_big, b_small)):
+        r = np.concatenate([K @ U[:, j] + C.T @ L[:, j] - b, C @ U[:, j]])
+        worst = max(worst, np.linalg.norm(r) / np.linalg.norm(b))
+    assert worst <= 1e-6 and rel <= 1e-6
