@@ -180,8 +180,8 @@ class PathOptions:
         plain stretch of the path (not towards a limit point nor past a jumped one) and where its
         cubic term is smaller than its quadratic one, else the quadratic.  Measured against
         "quadratic" (factorisations of the path, 2026-11-28, reproducible factorisations): fewer on
-        smooth paths -- the 10k ball's pinch 19 against 22 (8 path points against 10; 11.3 against
-        12.8 s), the 32-ring hemisphere (benchmarks/nonlinear) 124 against 151, the slit annular
+        smooth paths -- the 10k ball's pinch 19 against 22 (8 path points against 10; 11.2 against
+        12.7 s), the 32-ring hemisphere (benchmarks/nonlinear) 124 against 151, the slit annular
         plate 207 against 277 -- but more through the snaps of the full pinched cylinder (192 x 96:
         333 against 257; 4 failed steps of up to 24 factorisations against 1), so not the default.  Where the contact
         set changes from step to step (graspdef's finger-contact paths) u(lam) has a kink at each
@@ -540,21 +540,22 @@ class PathSolver:
         far = False                 # a step on a fresh tangent did not contract: no inexact steps
         self.last_step = np.inf
 
-        def direction(st, cres, fresh=True):
+        def direction(st, cres, fresh=True, stability=False):
             """The Newton step on the last factorisation: with a single-precision factor, solved to
             a forcing tolerance (an inexact Newton step, |F + J s| <= eta |F|; Dembo, Eisenstat &
             Steihaug 1982) instead of refined to a double solve's backward error: on a tangent
             factorised at this iterate (``fresh``) eta = NEWTON_FORCING min(rel, 0.1) of the
             projected residual, below Newton's own O(|F|^2) term; on a reused one eta =
             STALE_FORCING, below what the stale tangent itself leaves.  A double factor's solve is
-            as always."""
+            as always.  ``stability``: the factorisation was just made to give the point's stability
+            (the load tangent is solved along, see below)."""
             if not eq.kkt.single:
                 return eq.solve(-st.gradient, cres)
             gn = max(float(np.linalg.norm(st.gradient)), 1e-300)
             eta_n = NEWTON_FORCING * min(rel, 0.1) if fresh else STALE_FORCING
             rtol = max(1e-8, eta_n * self.residual_norm / gn)
-            if fresh and near is not None:
-                # the factorisation that gives the stability is, once converged, the next step's
+            if stability:
+                # the factorisation that gives the stability (just made) is, once converged, the next step's
                 # predictor: its tangent du/dlam = A^-1 q rides in this step's back-substitutions
                 # (:meth:`_load_tangent`)
                 both = eq.solve(np.stack([-st.gradient, st.load], 1), np.stack([cres, eq.g], 1), exact=False)
@@ -588,7 +589,7 @@ class PathSolver:
             if not keep_near:
                 near = (inst, rel) if rel <= opt.inertia_rtol else None
             inexact, hist = False, []
-            return st, direction(st, cres), True
+            return st, direction(st, cres, stability=not keep_near and near is not None), True
 
         max_it = 4 * opt.max_iterations if patient else opt.max_iterations if budget is None else budget
         for it in range(max_it + 1):
@@ -635,7 +636,7 @@ class PathSolver:
                 near = (inst, rel) if rel <= opt.inertia_rtol else None
                 hist, inexact = [], False
             if not fresh:
-                du = direction(st, cres, fresh=need_h)
+                du = direction(st, cres, fresh=need_h, stability=need_h and near is not None)
             # the supports hold to solve precision: the step need not restore them, and the energy
             # is a merit function along it
             feasible = float(np.linalg.norm(cres)) <= 1e-8 * max(float(np.linalg.norm(u)), float(np.linalg.norm(du)),
