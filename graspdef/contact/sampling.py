@@ -146,7 +146,7 @@ class SampleOperator:
             if k:
                 sample_rows_hessian(self._ptr, self._vals, self._pptr, self._pos, pat.base, pat.stride,
                                     np.ascontiguousarray(H, dtype=float), np.asarray(rows, np.int64), data)
-            return sp.csr_matrix((data, pat.scalar_indices, pat.scalar_indptr), shape=(n3, n3))
+            return pat.csr(data)
         if k == 0:
             return sp.csr_matrix((n3, n3))
         S3 = sp.kron(self.S[rows], sp.identity(3, format="csr"), format="csr")

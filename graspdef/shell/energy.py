@@ -127,6 +127,15 @@ class BlockPattern:
         self.scalar_indices = np.empty(9 * self.nnzb, itype)
         self.base, self.stride = scalar_pattern(self.indptr, self.cols, self.scalar_indptr, self.scalar_indices)
 
+    def csr(self, data: np.ndarray) -> sp.csr_matrix:
+        """The (3 n, 3 n) CSR matrix of this pattern with ``data`` (in CSR order), flagged as in
+        canonical format -- sorted, no duplicate entries: so the pattern is built (G's sorted block
+        columns, 3 x 3 blocks written row by row), and scipy would otherwise check it with a pass over
+        the indices of every matrix (the round-off level and the tangent's one-pass sum need it)."""
+        M = sp.csr_matrix((data, self.scalar_indices, self.scalar_indptr), shape=(3 * self.n, 3 * self.n))
+        M.has_canonical_format = True
+        return M
+
     def assemble(self, group_blocks: list[list[tuple[np.ndarray, np.ndarray]]]) -> sp.csr_matrix:
         """Sum element blocks into a CSR matrix; ``group_blocks[g]`` lists (face_slice, blocks
         (nf, S, S, 3, 3)) chunks in face order."""
@@ -136,7 +145,7 @@ class BlockPattern:
             for sl, blk in chunks:
                 S = blk.shape[1]
                 scatter_blocks(data, m[sl.start * S * S: sl.stop * S * S], blk, self.base, self.stride)
-        return sp.csr_matrix((data, self.scalar_indices, self.scalar_indptr), shape=(3 * self.n, 3 * self.n))
+        return self.csr(data)
 
 
 def block_pattern(shell: Shell) -> BlockPattern:
@@ -235,8 +244,7 @@ class ShellEnergy:
 
     def _csr(self, data: np.ndarray) -> sp.csr_matrix:
         """The pattern's CSR matrix with ``data`` (already in CSR order: see ``assemble_elements``)."""
-        p = self.pattern
-        return sp.csr_matrix((data, p.scalar_indices, p.scalar_indptr), shape=(3 * p.n, 3 * p.n))
+        return self.pattern.csr(data)
 
     def energy(self, x: np.ndarray) -> float:
         """Total elastic energy [J] at control points ``x`` (n_control, 3) [m]."""

@@ -173,7 +173,7 @@ class EnclosedVolume:
         if order == 2:
             if hessian_scale != 1.0:
                 data *= hessian_scale
-            H = sp.csr_matrix((data, pat.scalar_indices, pat.scalar_indptr), shape=(3 * pat.n, 3 * pat.n))
+            H = pat.csr(data)
         return float(V), grad.ravel(), H
 
     def value(self, x: np.ndarray) -> float:

@@ -1,9 +1,10 @@
-"""Compiled kernels of the sparse solver (numba): the pattern of the KKT matrix's upper triangle and its values."""
+"""Compiled kernels of the sparse solver (numba): the pattern of the KKT matrix's upper triangle and
+its values; the row sums a tangent's factorisation and round-off level need."""
 from __future__ import annotations
 
 import numpy as np
 
-from ..compiled import kernel
+from ..compiled import kernel, prange
 
 
 @kernel(aot=("UniTuple(i8[::1], 3)(i8[::1], i8[::1], i8[::1], i8[::1], i8, i8)",))
@@ -63,3 +64,78 @@ def kkt_upper_values(src, k_data, ct_data, scale):
         else:
             out[q] = 0.0
     return out
+
+
+#: rows longer than this (plus one) are summed by numpy in :func:`graspdef.solve.sparse.row_summary`
+#: (numpy's pairwise summation recurses above its block of 128 entries)
+PAIRWISE_BLOCK = 128
+
+
+@kernel(parallel=True, work=6,     # int64 indices (> 2**31 entries): JIT
+        aot=("void(i4[::1], i4[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1])",))
+def row_sums(indptr, indices, a, b, out, x2, abs_sums, sq_sums, diag):
+    """One pass over a CSR matrix's rows (in parallel: each row is its own): with ``b`` not empty
+    the matrix is a + b (same structure), written to ``out``; per row i
+
+    * ``abs_sums[i]`` = sum_j |h_ij|, summed as numpy's ``add.reduceat`` sums a row (the first entry
+      plus numpy's pairwise sum of the rest: eight accumulators, combined ((0+1)+(2+3))+((4+5)+(6+7)),
+      then the tail), so that it equals ``graspdef.solve.sparse._abs_row_sums`` to the bit -- except
+      rows of more than PAIRWISE_BLOCK + 1 entries, where numpy recurses: -1 there, left to numpy
+      (:func:`graspdef.solve.sparse.row_summary`);
+    * ``sq_sums[i]`` = sum_j h_ij^2 x2_j, in index order (scipy's ``csr_matvec``'s order);
+    * ``diag[i]`` = the sum of the row's entries in column i (scipy's ``diagonal``)."""
+    n = abs_sums.shape[0]
+    add = b.shape[0] > 0
+    for i in prange(n):
+        lo = indptr[i]
+        hi = indptr[i + 1]
+        s = 0.0
+        d = 0.0
+        for p in range(lo, hi):
+            h = a[p]
+            if add:
+                h = h + b[p]
+                out[p] = h
+            s += (h * h) * x2[indices[p]]
+            if indices[p] == i:
+                d += h
+        sq_sums[i] = s
+        diag[i] = d
+        m = hi - lo - 1                      # the entries after the first
+        if m < 0:
+            abs_sums[i] = 0.0
+            continue
+        if m > PAIRWISE_BLOCK:
+            abs_sums[i] = -1.0
+            continue
+        v = out if add else a
+        if m < 8:
+            r = 0.0
+            for p in range(lo + 1, hi):
+                r += abs(v[p])
+        else:
+            q = lo + 1
+            r0 = abs(v[q])
+            r1 = abs(v[q + 1])
+            r2 = abs(v[q + 2])
+            r3 = abs(v[q + 3])
+            r4 = abs(v[q + 4])
+            r5 = abs(v[q + 5])
+            r6 = abs(v[q + 6])
+            r7 = abs(v[q + 7])
+            k = 8
+            while k < m - m % 8:
+                r0 += abs(v[q + k])
+                r1 += abs(v[q + k + 1])
+                r2 += abs(v[q + k + 2])
+                r3 += abs(v[q + k + 3])
+                r4 += abs(v[q + k + 4])
+                r5 += abs(v[q + k + 5])
+                r6 += abs(v[q + k + 6])
+                r7 += abs(v[q + k + 7])
+                k += 8
+            r = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+            while k < m:
+                r += abs(v[q + k])
+                k += 1
+        abs_sums[i] = abs(v[lo]) + r

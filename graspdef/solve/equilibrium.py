@@ -38,7 +38,7 @@ from ..errors import SolverError
 from ..problem.problem import Problem
 from ..problem.terms import EnergyTerm
 from .krylov import gmres
-from .sparse import KKTSystem, same_array, union_sum
+from .sparse import KKTSystem, RowSummary, row_summary, same_array, union_sum
 
 
 def _add(A: sp.spmatrix, B: sp.spmatrix) -> sp.csr_matrix:
@@ -72,6 +72,7 @@ class State:
     load: np.ndarray
     internal: np.ndarray | None = None      # elastic forces dE/dx + dPi_N/dx (the force scale)
     floor: float | None = None               # round-off level of |gradient| (order 2 only), see roundoff_floor
+    rows: RowSummary | None = None           # the Hessian's row numbers for its factorisation (tangent_sum)
     terms: list | None = None                # each term's TermValue, in order (``keep_terms`` only)
 
 
@@ -101,6 +102,27 @@ def roundoff_floor(H: sp.csr_matrix, x: np.ndarray) -> float:
         H.sum_duplicates()
     H2 = sp.csr_matrix((H.data * H.data, H.indices, H.indptr), shape=H.shape)    # H o H on H's structure
     return float(ROUNDOFF_FACTOR * np.finfo(float).eps * np.linalg.norm(np.sqrt(H2 @ (x * x))))
+
+
+def tangent_sum(hessians: list, x: np.ndarray) -> tuple[sp.csr_matrix | None, RowSummary | None, float]:
+    """The sum of the terms' Hessians (in their order, as :func:`_add` sums them), its
+    :class:`~graspdef.solve.sparse.RowSummary` (None where it is not made) and its
+    :func:`roundoff_floor`.  Where the last two share their index arrays (the shell's pattern) and
+    the sum is in canonical format, the last sum, the floor's products and the factorisation's row
+    numbers are one pass (:func:`graspdef.solve.sparse.row_summary`), with the same numbers to the bit."""
+    if not hessians:
+        return None, None, 0.0
+    H = hessians[0]
+    for B in hessians[1:-1]:
+        H = _add(H, B)
+    B = hessians[-1] if len(hessians) > 1 else None
+    if not (sp.isspmatrix_csr(H) and H.nnz and (B is None or (
+            sp.isspmatrix_csr(B) and B.nnz and same_array(H.indices, B.indices) and same_array(H.indptr, B.indptr)))
+            and H.has_canonical_format):
+        H = H if B is None else _add(H, B)
+        return H, None, roundoff_floor(H, x)
+    H, rows, sq = row_summary(H, B, x)
+    return H, rows, float(ROUNDOFF_FACTOR * np.finfo(float).eps * np.linalg.norm(np.sqrt(sq)))
 
 
 class Equilibrium:
@@ -139,7 +161,8 @@ class Equilibrium:
         sums over the terms, in their order (``keep_terms``: each term's part too, ``State.terms``)."""
         x = self.X + u.reshape(-1, 3)
         E = None
-        grad = H = internal = None
+        grad = internal = None
+        hessians: list = []
         rank_one: list = []
         q = np.zeros(self.n)
         parts = [] if keep_terms else None
@@ -157,13 +180,14 @@ class Equilibrium:
                     q = q + load
             if order == 2:
                 if v.hessian is not None:
-                    H = v.hessian if H is None else _add(H, v.hessian)
+                    hessians.append(v.hessian)
                 rank_one += v.rank_one
-        floor = roundoff_floor(H, x) if order == 2 else None
-        self.n_hessians += order == 2
-        if floor is not None:
+        H = rows = floor = None
+        if order == 2:
+            H, rows, floor = tangent_sum(hessians, x)
             self.floor = floor
-        return State(float(E), grad, H if order == 2 else None, rank_one, q, internal, floor, parts)
+        self.n_hessians += order == 2
+        return State(float(E), grad, H, rank_one, q, internal, floor, rows=rows, terms=parts)
 
     def energy(self, u: np.ndarray, lam: float) -> float:
         return self.evaluate(u, lam, order=0).energy
@@ -197,7 +221,7 @@ class Equilibrium:
         eigenvalues of H on the constraint null space; 0 = stable) or None (no inertia).
         ``inertia=False``: the caller will not report this factor's inertia (a Newton iterate far
         from equilibrium), so a single-precision factor's is neither certified nor returned (None)."""
-        self.kkt.factor(state.hessian)
+        self.kkt.factor(state.hessian, rows=state.rows)
         self._lowrank = None
         V = c = start = None
         if state.rank_one:
