@@ -49,8 +49,9 @@ KERNEL_MODULES = ("graspdef.shell._kernels", "graspdef.shell.volume", "graspdef.
                   "graspdef.contact._kernels")
 
 #: a kernel that is parallel in the JIT build runs serially ahead of time only up to this much work
-#: (``args[work].shape[0]``: faces, points or rows): the 40 x 40 plate's 3,200 faces go there, the
-#: 2,562-vertex ball's 5,120 faces (a nonlinear path of ~50 Hessians) keep both cores
+#: (``args[work].shape[0]`` per the kernel's ``per_face``: faces or points, or rows of the stiffness
+#: at 1.5 per face): the 40 x 40 plate's 3,200 faces (5,043 rows) go there, the 2,562-vertex ball's
+#: 5,120 faces (a nonlinear path of ~50 Hessians; 7,686 rows) keep both cores
 SERIAL_MAX = 4096
 
 AOT_NAME = "_aot"                              # graspdef/_aot*.so and graspdef/_aot.json
@@ -68,11 +69,12 @@ class Kernel:
     """A compiled kernel (see the module's docstring).  ``signatures``: numba signature strings
     of the ahead-of-time exports (none: JIT only, e.g. a helper that only kernels call)."""
 
-    def __init__(self, fn, parallel: bool, signatures: tuple[str, ...], work: int):
+    def __init__(self, fn, parallel: bool, signatures: tuple[str, ...], work: int, per_face: float = 1.0):
         self.py_func = fn
         self.parallel = parallel
         self.signatures = signatures
         self.work = work
+        self.per_face = per_face
         self.__name__, self.__qualname__, self.__doc__ = fn.__name__, fn.__qualname__, fn.__doc__
         self.__module__ = fn.__module__
         self._jit = None                 # numba dispatcher, once the JIT build is made
@@ -90,7 +92,7 @@ class Kernel:
             self._aot = _aot_exports(self)
         if _recorder is not None:
             _record(self, args)
-        if self._aot and (not self.parallel or args[self.work].shape[0] <= SERIAL_MAX):
+        if self._aot and (not self.parallel or args[self.work].shape[0] <= self.per_face * SERIAL_MAX):
             for f, spec in self._aot:
                 if _matches(args, spec):
                     return f(*args)
@@ -104,12 +106,16 @@ class Kernel:
         return self._jit
 
 
-def kernel(*, parallel: bool = False, aot: tuple[str, ...] | list[str] = (), work: int = 0):
+def kernel(*, parallel: bool = False, aot: tuple[str, ...] | list[str] = (), work: int = 0,
+           per_face: float = 1.0):
     """Decorator of a kernel: ``parallel`` -- its ``prange`` loops run on all cores in the JIT
     build; ``aot`` -- numba signature strings to export ahead of time; ``work`` -- the argument
-    whose ``shape[0]`` measures a parallel kernel's work (:data:`SERIAL_MAX`)."""
+    whose ``shape[0]`` measures a parallel kernel's work (:data:`SERIAL_MAX`); ``per_face`` -- how
+    many of its units a face of the shell makes (faces, points: 1; rows of a shell's stiffness, three
+    per control vertex and about two faces per vertex: 1.5), so that one problem's kernels go to the
+    same build."""
     def wrap(fn):
-        return Kernel(fn, parallel, tuple(aot), work)
+        return Kernel(fn, parallel, tuple(aot), work, per_face)
     return wrap
 
 
