@@ -4,13 +4,18 @@ with ``--ref`` (bench_speed.py, bench_nonlinear_speed.py, bench_grasp_speed.py).
 
 The kernels' ahead-of-time module (``graspdef/_aot*``, built by ``make setup``, not in git) is
 copied into OLD as well, so that both trees run the same compiled kernels: the module carries the
-SHA-256 of the kernel sources it was built from and is ignored where they differ (graspdef.compiled),
-so an OLD tree with other kernels runs numba's JIT build as it would on its own."""
+SHA-256 of the kernel sources it was built from and is ignored where they differ
+(graspdef.compiled).  Where they differ, OLD's own module is built from OLD's sources (``python -m
+graspdef.compiled`` in OLD, ~8 s), as ``make setup`` would on a checkout of OLD: until 2026-11-28
+such an OLD tree ran numba's JIT build for every kernel, which its start-up (~0.3 s per process)
+made slower than it is -- the pad grasp against a7ac2f9, whose kernels differ, by 0.3 s."""
 from __future__ import annotations
 
 import contextlib
+import os
 import shutil
 import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
@@ -28,7 +33,23 @@ def code_trees(root: Path, ref: str | None, prefix: str = "bench_"):
                    capture_output=True, check=True)
     for aot in (root / "graspdef").glob("_aot*"):
         shutil.copy2(aot, tmp / "old" / "graspdef" / aot.name)
+    _own_aot(tmp / "old")
     try:
         yield {"OLD": tmp / "old", "NEW": root}
     finally:
         subprocess.run(["git", "-C", str(root), "worktree", "remove", "--force", str(tmp / "old")], capture_output=True)
+
+
+def _own_aot(tree: Path) -> None:
+    """Build ``tree``'s own ahead-of-time kernel module when the copied one is not for its kernel
+    sources (a tree from before the module existed has nothing to build)."""
+    if not (tree / "graspdef" / "compiled.py").exists():
+        return
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    status = subprocess.run([sys.executable, "-c", "from graspdef import compiled; print(compiled.aot_status())"],
+                            cwd=tree, env=env, capture_output=True, text=True).stdout.strip()
+    if status.startswith("ahead-of-time kernels in use"):
+        return
+    print(f"building OLD's own ahead-of-time kernels ({status.splitlines()[-1] if status else 'no module'})",
+          file=sys.stderr, flush=True)
+    subprocess.run([sys.executable, "-m", "graspdef.compiled"], cwd=tree, env=env, capture_output=True, check=True)
