@@ -92,11 +92,17 @@ class Kernel:
             self._aot = _aot_exports(self)
         if _recorder is not None:
             _record(self, args)
-        if self._aot and (not self.parallel or args[self.work].shape[0] <= self.per_face * SERIAL_MAX):
+        if self._aot and self.serial(args[self.work].shape[0]):
             for f, spec in self._aot:
                 if _matches(args, spec):
                     return f(*args)
         return self.jit(*args)
+
+    def serial(self, work: int) -> bool:
+        """Whether a call with this much work (``args[work].shape[0]``) runs serially ahead of time
+        (when the module is there): a serial kernel always, a parallel one up to ``per_face``
+        :data:`SERIAL_MAX`."""
+        return not self.parallel or work <= self.per_face * SERIAL_MAX
 
     @property
     def jit(self):

@@ -151,9 +151,15 @@ def csr_product(A: sp.csr_matrix, x: np.ndarray) -> np.ndarray:
     (:func:`graspdef.solve._kernels.csr_products`): scipy's numbers to the bit (each entry summed in
     index order), A read once per block.  On the 10k ball's tangent (3.4 M entries) one column takes
     2.8 ms where scipy's takes 4.3 when A is not in cache -- as between a path's back-substitutions,
-    which read the 82 MB factor -- and the same 1.8 ms when it is."""
+    which read the 82 MB factor -- and the same 1.8 ms when it is.  A matrix whose product would run
+    serially (graspdef.compiled.SERIAL_MAX) is multiplied by scipy, one column at a time (the
+    kernel's call cost more than the product: 224 against 100 us at 1,926 rows)."""
     from ._kernels import csr_products
 
+    if csr_products.serial(A.shape[0]):
+        if np.ndim(x) == 1:
+            return A @ x
+        return np.column_stack([A @ x[:, j] for j in range(x.shape[1])]).reshape(np.shape(x))
     ip, ix = A.indptr, A.indices
     if ip.dtype != ix.dtype or ip.dtype not in (np.int32, np.int64):
         ip, ix = ip.astype(np.int64), ix.astype(np.int64)

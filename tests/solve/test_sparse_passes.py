@@ -117,10 +117,16 @@ def test_other_structures_keep_the_separate_passes():
 
 @pytest.mark.parametrize("dtype", [np.int32, np.int64])
 @pytest.mark.parametrize("k", [None, 1, 2, 3, 5])
-def test_the_parallel_product_is_scipys_to_the_bit(dtype, k):
+@pytest.mark.parametrize("parallel", [True, False])
+def test_the_parallel_product_is_scipys_to_the_bit(dtype, k, parallel, monkeypatch):
     """A x for one column (n,), and blocks of 1, 2 (one read of A) and 3 or 5 columns: each
     column equals scipy's one-column product exactly, on rows of 0 to 300 entries, with unsorted
-    and duplicated column indices (the product sums in index order, as scipy's does)."""
+    and duplicated column indices (the product sums in index order, as scipy's does) -- by the
+    parallel kernel (forced here: below graspdef.compiled.SERIAL_MAX scipy multiplies) and by scipy."""
+    from graspdef import compiled
+
+    if parallel:
+        monkeypatch.setattr(compiled, "SERIAL_MAX", -1)
     n = 300
     rng = np.random.default_rng(7)
     A, _ = _random_csr(n, rng.integers(0, 160, n), 8, dtype)
