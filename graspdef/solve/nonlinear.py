@@ -180,8 +180,8 @@ class PathOptions:
         plain stretch of the path (not towards a limit point nor past a jumped one) and where its
         cubic term is smaller than its quadratic one, else the quadratic.  Measured against
         "quadratic" (factorisations of the path, 2026-11-28, reproducible factorisations): fewer on
-        smooth paths -- the 10k ball's pinch 19 against 22 (8 path points against 10; 11.2 against
-        12.7 s), the 32-ring hemisphere (benchmarks/nonlinear) 124 against 151, the slit annular
+        smooth paths -- the 10k ball's pinch 19 against 22 (8 path points against 10; 10.3 against
+        12.2 s), the 32-ring hemisphere (benchmarks/nonlinear) 124 against 151, the slit annular
         plate 207 against 277 -- but more through the snaps of the full pinched cylinder (192 x 96:
         333 against 257; 4 failed steps of up to 24 factorisations against 1), so not the default.  Where the contact
         set changes from step to step (graspdef's finger-contact paths) u(lam) has a kink at each
