@@ -101,7 +101,12 @@ def roundoff_floor(H: sp.csr_matrix, x: np.ndarray) -> float:
         H = H.copy()
         H.sum_duplicates()
     H2 = sp.csr_matrix((H.data * H.data, H.indices, H.indptr), shape=H.shape)    # H o H on H's structure
-    return float(ROUNDOFF_FACTOR * np.finfo(float).eps * np.linalg.norm(np.sqrt(H2 @ (x * x))))
+    return _floor(H2 @ (x * x))
+
+
+def _floor(sq: np.ndarray) -> float:
+    """:func:`roundoff_floor` from the row sums sq_i = sum_j H_ij^2 x_j^2."""
+    return float(ROUNDOFF_FACTOR * np.finfo(float).eps * np.linalg.norm(np.sqrt(sq)))
 
 
 def tangent_sum(hessians: list, x: np.ndarray) -> tuple[sp.csr_matrix | None, RowSummary | None, float]:
@@ -122,7 +127,7 @@ def tangent_sum(hessians: list, x: np.ndarray) -> tuple[sp.csr_matrix | None, Ro
         H = H if B is None else _add(H, B)
         return H, None, roundoff_floor(H, x)
     H, rows, sq = row_summary(H, B, x)
-    return H, rows, float(ROUNDOFF_FACTOR * np.finfo(float).eps * np.linalg.norm(np.sqrt(sq)))
+    return H, rows, _floor(sq)
 
 
 class Equilibrium:
