@@ -102,6 +102,15 @@ def _cnr_threads(solver) -> int:
         return 1
 
 
+def _kernel_indices(A: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
+    """A's index arrays as the sparse kernels take them: contiguous, both int32 (the ahead-of-time
+    build's type, as scipy keeps them) or both int64."""
+    ip, ix = A.indptr, A.indices
+    if ip.dtype != ix.dtype or ip.dtype not in (np.int32, np.int64):
+        ip, ix = ip.astype(np.int64), ix.astype(np.int64)
+    return np.ascontiguousarray(ip), np.ascontiguousarray(ix)
+
+
 @dataclass(frozen=True)
 class RowSummary:
     """Per-row numbers of a matrix K that its KKT factorisation needs (:meth:`KKTSystem.factor`:
@@ -126,16 +135,14 @@ def row_summary(A: sp.csr_matrix, B: sp.csr_matrix | None = None,
     from ._kernels import row_sums
 
     n = A.shape[0]
-    ip, ix = A.indptr, A.indices
-    if ip.dtype != ix.dtype or ip.dtype not in (np.int32, np.int64):
-        ip, ix = ip.astype(np.int64), ix.astype(np.int64)
+    ip, ix = _kernel_indices(A)
     a = np.ascontiguousarray(A.data, float)
     b = np.zeros(0) if B is None else np.ascontiguousarray(B.data, float)
     out = np.empty_like(a) if B is not None else np.zeros(0)
     xf = None if x is None else np.asarray(x, float).ravel()
     x2 = np.zeros(n) if xf is None else np.ascontiguousarray(xf * xf)
     abs_sums, sq, diag = np.empty(n), np.empty(n), np.empty(n)
-    row_sums(np.ascontiguousarray(ip), np.ascontiguousarray(ix), a, b, out, x2, abs_sums, sq, diag)
+    row_sums(ip, ix, a, b, out, x2, abs_sums, sq, diag)
     data = a if B is None else out
     long_rows = np.flatnonzero(abs_sums < 0)          # numpy's own recursive pairwise sums
     for i in long_rows:
@@ -160,9 +167,7 @@ def csr_product(A: sp.csr_matrix, x: np.ndarray) -> np.ndarray:
         if np.ndim(x) == 1:
             return A @ x
         return np.column_stack([A @ x[:, j] for j in range(x.shape[1])]).reshape(np.shape(x))
-    ip, ix = A.indptr, A.indices
-    if ip.dtype != ix.dtype or ip.dtype not in (np.int32, np.int64):
-        ip, ix = ip.astype(np.int64), ix.astype(np.int64)
+    ip, ix = _kernel_indices(A)
     X = np.ascontiguousarray(np.asarray(x, float).reshape(A.shape[1], -1))
     Y = np.empty((A.shape[0], X.shape[1]))
     csr_products(ip, ix, np.ascontiguousarray(A.data, float), X, Y)
