@@ -563,6 +563,13 @@ class PathSolver:
                 return both[:, 0]
             return eq.solve(-st.gradient, cres, rtol=min(rtol, 0.1), exact=False)
 
+        def ahead(st, cres):
+            """The right-hand sides of ``direction``'s solve on a factorisation that gives the
+            stability (for :meth:`Equilibrium.factor` to refine in the certificate's steps)."""
+            if not eq.kkt.single:
+                return None
+            return np.stack([-st.gradient, st.load], 1), np.stack([cres, eq.g], 1)
+
         def refresh(u, st, cres, tight=False, keep_near=False):
             """A step on the tangent at u (``st`` its state): inexact (GMRES) if it converges
             within ``krylov`` iterations (to krylov_rtol if ``tight``), else on a fresh
@@ -585,7 +592,8 @@ class PathSolver:
                     return st, di, False
             if st.hessian is None:
                 st = eq.evaluate(u, lam, 2)
-            inst = eq.factor(st, inertia=not keep_near and rel <= opt.inertia_rtol)
+            stab = not keep_near and rel <= opt.inertia_rtol
+            inst = eq.factor(st, inertia=stab, ahead=ahead(st, cres) if stab else None)
             if not keep_near:
                 near = (inst, rel) if rel <= opt.inertia_rtol else None
             inexact, hist = False, []
@@ -632,7 +640,8 @@ class PathSolver:
                 st, du, need_h = refresh(u, st, cres, tight=inexact and poor)
                 fresh = True
             if need_h and not fresh:
-                inst = eq.factor(st, inertia=rel <= opt.inertia_rtol)
+                inst = eq.factor(st, inertia=rel <= opt.inertia_rtol,
+                                 ahead=ahead(st, cres) if rel <= opt.inertia_rtol else None)
                 near = (inst, rel) if rel <= opt.inertia_rtol else None
                 hist, inexact = [], False
             if not fresh:

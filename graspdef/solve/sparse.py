@@ -478,7 +478,8 @@ class KKTSystem:
         factor's).  Nothing to do for a double factor (True).  See :meth:`certify_inertia_along`."""
         return self.certify_inertia_along(None)[0]
 
-    def certify_inertia_along(self, along: np.ndarray | None) -> tuple[bool, np.ndarray | None]:
+    def certify_inertia_along(self, along: np.ndarray | None,
+                              g: np.ndarray | None = None) -> tuple[bool, np.ndarray | None]:
         """:meth:`certify_inertia`, returning (its answer, start): ``start`` is None unless
         ``along`` is given (see below) and the factor was kept.
 
@@ -497,12 +498,14 @@ class KKTSystem:
         G's eigenvalue is ~1 and |y| stalls; that factor is then replaced by a double one.
         Costs 2-3 back-substitutions and products on the 10k ball's tangents (|y| shrinks by ~1e-6 per step).
 
-        ``along`` (n,) or (n, k): right-hand sides [f; 0] of the KKT system whose plain refinement
-        steps x <- x - M^-1 (A x - [f; 0]) from x = 0 ride in the certificate's back-substitutions
+        ``along`` (n,) or (n, k), ``g`` (m,) or (m, k) (zero if None): right-hand sides [f; g] of the
+        KKT system whose plain refinement steps x <- x - M^-1 (A x - [f; g]) from x = 0 ride in the
+        certificate's back-substitutions
         (one call of several columns: PARDISO's back-substitution reads the factor once per call,
         and on the 10k ball's tangent, 30,732 unknowns, one column took 12.4 ms, two 14.3 and four
         14.1); ``start`` is then their iterates, (n + m,) or (n + m, k), a start for :meth:`solve`
-        (the Woodbury vectors of a rank-one part: graspdef.solve.equilibrium.Equilibrium.factor)."""
+        (the Woodbury vectors of a rank-one part and the Newton step and load tangent on a factor
+        that gives a stability: graspdef.solve.equilibrium.Equilibrium.factor)."""
         if not self.single or not self._pardiso:
             return True, None
         N = self.n + self.m
@@ -511,7 +514,9 @@ class KKTSystem:
         B = X = None
         if along is not None:
             f = np.asarray(along, float)
-            B = np.concatenate([f.reshape(self.n, -1), np.zeros((self.m, f.size // self.n))])
+            k = f.size // self.n
+            G = np.zeros((self.m, k)) if g is None else np.asarray(g, float).reshape(self.m, k)
+            B = np.concatenate([f.reshape(self.n, -1), self.scale * G])
             X = np.zeros_like(B)
         ok = False
         for k in range(MIXED_REFINEMENTS):

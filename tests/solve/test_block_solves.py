@@ -160,3 +160,45 @@ def test_each_column_of_a_block_is_solved_to_its_own_tolerance():
         r = np.concatenate([K @ U[:, j] + C.T @ L[:, j] - b, C @ U[:, j]])
         worst = max(worst, np.linalg.norm(r) / np.linalg.norm(b))
     assert worst <= 1e-6 and rel <= 1e-6
+
+
+def test_the_stability_step_rides_in_the_certificate():
+    """A factorisation that gives a point's stability is told the right-hand sides of its next
+    solve (the Newton step and the load tangent, with the supports' residuals: what
+    PathSolver.newton's direction solves there): their refinement steps ride in the certificate's
+    back-substitution calls -- as many calls as the certificate alone -- and that solve then needs
+    no call of its own, where from scratch it needs two or more; each column is the solve from
+    scratch to 1e-7 of its size, the inertia the same.  Other right-hand sides after it are solved
+    from scratch (the announced start is not theirs)."""
+    pr = _ball(2, 20.0)
+    u = (0.05 * Equilibrium(pr).X * np.array([0.5, 0.5, -1.0])).ravel()   # squashed along z
+    lam = 0.4
+    eq = Equilibrium(pr, precision="mixed")
+    try:
+        st = eq.evaluate(u, lam, 2)
+        cres = eq.constraint_residual(u, lam)
+        R, G = np.stack([-st.gradient, st.load], 1), np.stack([cres, eq.g], 1)
+        calls = lambda: eq.kkt.n_back_calls                       # noqa: E731
+        c0 = calls()
+        inst0 = eq.factor(st)
+        alone = calls() - c0
+        c0 = calls()
+        ref = eq.solve(R, G)
+        scratch = calls() - c0
+        c0 = calls()
+        inst = eq.factor(st, ahead=(R, G))
+        at_factor = calls() - c0
+        c0 = calls()
+        du = eq.solve(R, G)
+        after = calls() - c0
+        assert eq.kkt.single and inst == inst0
+        assert at_factor == alone and after == 0 < 2 <= scratch
+        for j in range(2):
+            assert np.linalg.norm(du[:, j] - ref[:, j]) <= 1e-7 * np.linalg.norm(ref[:, j])
+        eq.factor(st, ahead=(R, G))
+        c0 = calls()
+        other = eq.solve(R[:, 1], G[:, 1])
+        assert calls() - c0 >= 1
+        assert np.linalg.norm(other - ref[:, 1]) <= 1e-7 * np.linalg.norm(ref[:, 1])
+    finally:
+        eq.close()
