@@ -179,11 +179,12 @@ class PathOptions:
         "cubic": the Hermite cubic through the last two points with the tangents at both, on a
         plain stretch of the path (not towards a limit point nor past a jumped one) and where its
         cubic term is smaller than its quadratic one, else the quadratic.  Measured against
-        "quadratic" (factorisations of the path, 2026-11-28, reproducible factorisations): fewer on
+        "quadratic" (factorisations of the path, 2026-11-28, seventeenth session, a4ab414): fewer on
         smooth paths -- the 10k ball's pinch 19 against 22 (8 path points against 10; 10.3 against
-        12.2 s), the 32-ring hemisphere (benchmarks/nonlinear) 124 against 151, the slit annular
-        plate 207 against 277 -- but more through the snaps of the full pinched cylinder (192 x 96:
-        333 against 257; 4 failed steps of up to 24 factorisations against 1), so not the default.  Where the contact
+        11.6 s), the 32-ring hemisphere (benchmarks/nonlinear) 46 against 71, the slit annular
+        plate 169 against 241 -- but more on the displacement-controlled pinched cylinders, whose
+        post-snap stretch crosses a train of bifurcations (48 x 48: 220 against 211; 192 x 96: 249
+        against 183, ~90 s more of its ~300 s), so not the default.  Where the contact
         set changes from step to step (graspdef's finger-contact paths) u(lam) has a kink at each
         change and the curvature term overshoots: on the tennis ball's pads the linear predictor
         needs 45 factorisations instead of 54 for the same equilibria (to 1e-10)
