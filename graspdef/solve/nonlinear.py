@@ -541,6 +541,14 @@ class PathSolver:
         far = False                 # a step on a fresh tangent did not contract: no inexact steps
         self.last_step = np.inf
 
+        def ahead(st, cres):
+            """The right-hand sides of ``direction``'s solve on a factorisation that gives the
+            stability, the Newton step and the load tangent (told to :meth:`Equilibrium.factor`
+            beforehand, which refines them in the certificate's steps); None with a double factor."""
+            if not eq.kkt.single:
+                return None
+            return np.stack([-st.gradient, st.load], 1), np.stack([cres, eq.g], 1)
+
         def direction(st, cres, fresh=True, stability=False):
             """The Newton step on the last factorisation: with a single-precision factor, solved to
             a forcing tolerance (an inexact Newton step, |F + J s| <= eta |F|; Dembo, Eisenstat &
@@ -558,18 +566,11 @@ class PathSolver:
             if stability:
                 # the factorisation that gives the stability (just made) is, once converged, the next step's
                 # predictor: its tangent du/dlam = A^-1 q rides in this step's back-substitutions
-                # (:meth:`_load_tangent`)
-                both = eq.solve(np.stack([-st.gradient, st.load], 1), np.stack([cres, eq.g], 1), exact=False)
+                # (:meth:`_load_tangent`), and both started in the certificate's (``ahead``)
+                both = eq.solve(*ahead(st, cres), exact=False)
                 self._ahead = (eq.n_factorisations, st.load.copy(), both[:, 1])
                 return both[:, 0]
             return eq.solve(-st.gradient, cres, rtol=min(rtol, 0.1), exact=False)
-
-        def ahead(st, cres):
-            """The right-hand sides of ``direction``'s solve on a factorisation that gives the
-            stability (for :meth:`Equilibrium.factor` to refine in the certificate's steps)."""
-            if not eq.kkt.single:
-                return None
-            return np.stack([-st.gradient, st.load], 1), np.stack([cres, eq.g], 1)
 
         def refresh(u, st, cres, tight=False, keep_near=False):
             """A step on the tangent at u (``st`` its state): inexact (GMRES) if it converges
