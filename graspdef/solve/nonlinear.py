@@ -65,8 +65,8 @@ NEWTON_FORCING = 0.1
 STALE_FORCING = 1e-3
 
 #: First Newton iteration at which a residual grown tenfold over the first iterate's ends the
-#: attempt (PathSolver.newton).  Measured over 23 paths of the nonlinear benchmark set, both
-#: predictors (2026-11-28, 579 Newton solves): no solve that converged had a residual above ten
+#: attempt (PathSolver.newton).  Measured over 19 load-controlled paths of the nonlinear benchmark
+#: set (2026-11-28, 579 Newton solves): no solve that converged had a residual above ten
 #: times its first (relative or absolute) from iteration 4 on; of the 40 that failed, 8 had, most
 #: of them from their first step on (up to 5e8 times), and ran on to their 25 iterations.
 DIVERGENCE_ITERATIONS = 4
@@ -186,12 +186,12 @@ class PathOptions:
         "cubic": the Hermite cubic through the last two points with the tangents at both, on a
         plain stretch of the path (not towards a limit point nor past a jumped one) and where its
         cubic term is smaller than its quadratic one, else the quadratic.  Measured against
-        "quadratic" (factorisations of the path, 2026-11-28, seventeenth session, a4ab414): fewer on
+        "quadratic" (factorisations of the path, 2026-11-28, seventeenth session): fewer on
         smooth paths -- the 10k ball's pinch 19 against 22 (8 path points against 10; 10.3 against
         11.6 s), the 32-ring hemisphere (benchmarks/nonlinear) 46 against 71, the slit annular
         plate 169 against 241 -- but more on the displacement-controlled pinched cylinders, whose
-        post-snap stretch crosses a train of bifurcations (48 x 48: 220 against 211; 192 x 96: 249
-        against 183, ~90 s more of its ~300 s), so not the default.  Where the contact
+        post-snap stretch crosses a train of bifurcations (48 x 48: 220 against 200; neo-Hookean
+        186 against 155; 192 x 96: 220 against 177, 509 against 459 s), so not the default.  Where the contact
         set changes from step to step (graspdef's finger-contact paths) u(lam) has a kink at each
         change and the curvature term overshoots: on the tennis ball's pads the linear predictor
         needs 45 factorisations instead of 54 for the same equilibria (to 1e-10)
