@@ -195,7 +195,7 @@ class PathOptions:
         "cubic": the Hermite cubic through the last two points with the tangents at both, on a
         plain stretch of the path (not towards a limit point nor past a jumped one) and where its
         cubic term is smaller than its quadratic one, else the quadratic.  Measured against
-        "quadratic" (factorisations of the path, 2026-11-28, seventeenth session): fewer on
+        "quadratic" (factorisations of the path, 2026-11-28, seventeenth session, 405bbc4): fewer on
         smooth paths -- the 10k ball's pinch 19 against 22 (8 path points against 10; 10.3 against
         11.6 s), the 32-ring hemisphere (benchmarks/nonlinear) 46 against 71, the slit annular
         plate 169 against 241 -- but more on the displacement-controlled pinched cylinders, whose
