@@ -573,25 +573,25 @@ class PathSolver:
                 return None
             return np.stack([-st.gradient, st.load], 1), np.stack([cres, eq.g], 1)
 
-        def direction(st, cres, fresh=True, stability=False):
+        def direction(st, cres, fresh=True, stability=None):
             """The Newton step on the last factorisation: with a single-precision factor, solved to
             a forcing tolerance (an inexact Newton step, |F + J s| <= eta |F|; Dembo, Eisenstat &
             Steihaug 1982) instead of refined to a double solve's backward error: on a tangent
             factorised at this iterate (``fresh``) eta = NEWTON_FORCING min(rel, 0.1) of the
             projected residual, below Newton's own O(|F|^2) term; on a reused one eta =
             STALE_FORCING, below what the stale tangent itself leaves.  A double factor's solve is
-            as always.  ``stability``: the factorisation was just made to give the point's stability
-            (the load tangent is solved along, see below)."""
+            as always.  ``stability``: the factorisation was just made to give the point's stability,
+            and this is what :func:`ahead` gave it (the load tangent is solved along, see below)."""
             if not eq.kkt.single:
                 return eq.solve(-st.gradient, cres)
             gn = max(float(np.linalg.norm(st.gradient)), 1e-300)
             eta_n = NEWTON_FORCING * min(rel, 0.1) if fresh else STALE_FORCING
             rtol = max(1e-8, eta_n * self.residual_norm / gn)
-            if stability:
+            if stability is not None:
                 # the factorisation that gives the stability (just made) is, once converged, the next step's
                 # predictor: its tangent du/dlam = A^-1 q rides in this step's back-substitutions
                 # (:meth:`_load_tangent`), and both started in the certificate's (``ahead``)
-                both = eq.solve(*ahead(st, cres), exact=False)
+                both = eq.solve(*stability, exact=False)
                 self._ahead = (eq.n_factorisations, st.load.copy(), both[:, 1])
                 return both[:, 0]
             return eq.solve(-st.gradient, cres, rtol=min(rtol, 0.1), exact=False)
@@ -619,11 +619,12 @@ class PathSolver:
             if st.hessian is None:
                 st = eq.evaluate(u, lam, 2)
             stab = not keep_near and rel <= opt.inertia_rtol
-            inst = eq.factor(st, inertia=stab, ahead=ahead(st, cres) if stab else None)
+            rhs = ahead(st, cres) if stab else None
+            inst = eq.factor(st, inertia=stab, ahead=rhs)
             if not keep_near:
                 near = (inst, rel) if rel <= opt.inertia_rtol else None
             inexact, hist = False, []
-            return st, direction(st, cres, stability=not keep_near and near is not None), True
+            return st, direction(st, cres, stability=rhs), True
 
         max_it = 4 * opt.max_iterations if patient else opt.max_iterations if budget is None else budget
         for it in range(max_it + 1):
@@ -673,13 +674,14 @@ class PathSolver:
                 # (to krylov_rtol if a looser inexact step did not contract)
                 st, du, need_h = refresh(u, st, cres, tight=inexact and poor)
                 fresh = True
+            rhs = None                    # the stability's right-hand sides, when this iteration factorises for it
             if need_h and not fresh:
-                inst = eq.factor(st, inertia=rel <= opt.inertia_rtol,
-                                 ahead=ahead(st, cres) if rel <= opt.inertia_rtol else None)
+                rhs = ahead(st, cres) if rel <= opt.inertia_rtol else None
+                inst = eq.factor(st, inertia=rel <= opt.inertia_rtol, ahead=rhs)
                 near = (inst, rel) if rel <= opt.inertia_rtol else None
                 hist, inexact = [], False
             if not fresh:
-                du = direction(st, cres, fresh=need_h, stability=need_h and near is not None)
+                du = direction(st, cres, fresh=need_h, stability=rhs)
             # the supports hold to solve precision: the step need not restore them, and the energy
             # is a merit function along it
             feasible = float(np.linalg.norm(cres)) <= 1e-8 * max(float(np.linalg.norm(u)), float(np.linalg.norm(du)),
