@@ -65,7 +65,7 @@ test-slow: setup
 	$(PY) -m pytest -q -m slow $(XDIST)
 
 # graspdef solve out of core end to end: MKL 2026.2's out-of-core mode fails about once in 120
-# runs of these on a busy machine (README "Out of core", cause open), so `make test` leaves them out
+# runs of these on a busy machine (docs/speed.md, "Out of core", cause open), so `make test` leaves them out
 test-ooc: setup
 	$(PY) -m pytest -q -m ooc_cli tests/solve/test_kkt_out_of_core.py
 

@@ -12,7 +12,7 @@ A kernel is a plain Python function of arrays decorated with :func:`kernel` in o
 * otherwise the **JIT build**: numba's ``njit`` (``cache=True``, parallel where declared), which
   compiles (or loads from numba's on-disk cache) every kernel of the module on the first such call.
 
-Why (issue 17, README "Start-up"): numba costs every process 0.17 s to import and 0.3-0.4 s on its
+Why (issue 17, docs/speed.md, "Start-up"): numba costs every process 0.17 s to import and 0.3-0.4 s on its
 first call even when its on-disk cache is warm (it installs its typing and lowering registries);
 the plate of 1,681 control vertices took 1.2-1.6 s as a whole process, of which ~0.5 s was that.
 The ahead-of-time module loads like any extension (a few ms) and needs no numba at run time.

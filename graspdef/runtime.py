@@ -27,7 +27,7 @@ it first thing, before any solve (it only helps speed, never changes a result):
   3: the linear 10k pinched cylinder's assembly 0.94 -> 0.57 s, the 2,562-vertex ball's nonlinear
   path 4.7 -> 4.2 s, the tennis-ball pad grasp 14.6 -> 13.6 s, every result the same; the 100k
   pinched cylinder's KKT solve failed its residual check with 2 threads and passed with 1 (an
-  edge not yet understood, README "Speed").  Like the
+  edge not yet understood, docs/speed.md).  Like the
   others it must be set before numpy is first imported (the command line calls configure before
   any numerical import; ``blas_threads_fixed`` in the returned dict says whether it was in time).
 

@@ -148,7 +148,7 @@ def console() -> None:
     output is flushed, without Python's and the C++ runtime's teardown: MKL 2026.2's out-of-core mode has been seen to
     crash a process *at exit*, after every result was written and correct (an LLVM assertion in
     numba's llvmlite, or a segfault; measured: 1 of 60 processes with two out-of-core solvers,
-    1 of 30 ``graspdef solve`` runs in the test suite, README "Out of core"), which turned a
+    1 of 30 ``graspdef solve`` runs in the test suite, docs/speed.md, "Out of core"), which turned a
     finished run's status 0 into -6.  Everything the run writes is closed before (its files, the
     solver's temporary folder).  Those crashes were measured before 2026-11-27, when three causes of
     memory corruption were found and avoided (a one-byte heap overflow in MKL for a folder given

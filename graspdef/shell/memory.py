@@ -15,7 +15,7 @@ BYTES_PER_VERTEX_OUT_OF_CORE = 30_000.0
 #: a linear solve (one Hessian, one factor) per control vertex above BYTES_FIXED, by the precision of
 #: its factor: the 100,800-vertex pinched cylinder peaked at 2.65 GiB with the mixed-precision factor
 #: (24 kB per vertex above the fixed part) and at 4.21 GiB with the double one (41 kB), one process
-#: each (VmHWM, 2026-11-27, README "Mixed precision"); rounded up.  "auto" is mixed from 20,000
+#: each (VmHWM, 2026-11-27, docs/speed.md, "Mixed precision"); rounded up.  "auto" is mixed from 20,000
 #: unknowns on and double below, where either estimate is under 0.7 GB
 BYTES_PER_VERTEX_LINEAR = {"mixed": 30_000.0, "auto": 30_000.0, "double": 45_000.0}
 

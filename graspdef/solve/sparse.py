@@ -426,7 +426,7 @@ class KKTSystem:
             raise SolverError(
                 f"PARDISO out of core: the matrix's sparsity pattern changed ({a.indices.size:,} analysed non-zeros, "
                 f"{union.nnz:,} now), which needs a second analysis, and out of core that needs a second "
-                "PARDISO handle in the process (refused: README, 'Out of core'); solve this problem in core "
+                "PARDISO handle in the process (refused: docs/speed.md, 'Out of core'); solve this problem in core "
                 "(backend 'pardiso') or with a fixed pattern")
         return union
 
@@ -440,7 +440,7 @@ class KKTSystem:
         signal: the system was closed, the memory doubled and the matrix analysed again -- and a
         solver re-created after that failure came out wrong in 3 of 260 processes (a solution 1 %
         off SuperLU's at a residual of 1e-12, a solve failing its check, a process ending without
-        output), against 0 of 120 without the failure (README, "Out of core")."""
+        output), against 0 of 120 without the failure (docs/speed.md, "Out of core")."""
         need_mb = math.ceil(need_kb * OOC_CORE_MARGIN / 1024)
         if need_kb <= 0 or self.ooc_core_mb >= need_mb:
             return
@@ -870,7 +870,7 @@ def require_sequential_mkl(lib) -> None:
     tests/solve/test_kkt_out_of_core.py in two loops side by side -- even with one handle per
     process -- and in none of 295 runs on the sequential layer.  Later (2026-11-27, ninth session)
     wrong factors came on the sequential layer too, of other values, with Python objects overwritten
-    in the same kind of process: 4 failures in 2,941 out-of-core processes (README, "Out of core"),
+    in the same kind of process: 4 failures in 2,941 out-of-core processes (docs/speed.md, "Out of core"),
     so this layer is not the cure of that fault; it stays because the threaded failures came more
     often (3 in ~205 runs of the file, each several out-of-core processes).  In-core
     PARDISO keeps the threaded layer, so one process cannot hold both: an out-of-core solve needs a
@@ -896,14 +896,14 @@ def require_one_ooc_handle() -> None:
     two to ten handles each (the cantilever's path re-analysed on a fresh handle: 2 segmentation
     faults in 281; ten plate solves on ten handles: an ``AttributeError`` inside pypardiso in 136)
     against 0 of 1,036 with one handle (900 plate solves; ten factorisations on one handle, 136),
-    and in 3 of 260 processes that re-created a handle after error -9 (README, "Out of core").  One
+    and in 3 of 260 processes that re-created a handle after error -9 (docs/speed.md, "Out of core").  One
     handle per process, analysed once: a pattern change inside the analysed pattern is factorised
     on it, any other is refused, as are PARDISO's fallback settings (a fresh handle each).  State
     of the process, like MKL's own: ``graspdef solve --backend pardiso-ooc`` is one process."""
     global _ooc_handle_created
     if _ooc_handle_created:
         raise SolverError("PARDISO out of core (backend 'pardiso-ooc') allows one solver per process: a second "
-                          "one in the same process corrupted memory (MKL 2026.2; README, 'Out of core'); run each "
+                          "one in the same process corrupted memory (MKL 2026.2; docs/speed.md, 'Out of core'); run each "
                           "out-of-core solve in a process of its own, e.g. graspdef solve PROBLEM --backend pardiso-ooc")
     _ooc_handle_created = True
 
@@ -995,7 +995,7 @@ _PARDISO_IPARM = {
     21: 0,      # 1x1 diagonal pivots (the constraint rows' zero pivots are static-pivoted and
                 # then refined; Bunch-Kaufman 2x2 pivots, 21 = 1, are the first fallback): the 10k
                 # ball's single-precision factor 0.21-0.23 s against 0.30-0.33 s with them, the same
-                # inertia (README, "1x1 pivots")
+                # inertia (docs/speed.md, "1×1 pivots")
     35: 1,      # zero-based indices (KKTSystem._call passes scipy's own)
 }
 

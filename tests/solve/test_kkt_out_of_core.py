@@ -1,6 +1,6 @@
 """PARDISO out of core (backend "pardiso-ooc", graspdef.solve.sparse): the factor goes to files in
 a temporary folder and only OOC_CORE_MB of it stays in memory -- for problems whose in-core factor
-does not fit (README "Speed": the 100k pinched cylinder).  Invariant: the solution is SuperLU's to
+does not fit (README "Speed": the 100k pinched cylinder; docs/speed.md, "Out of core").  Invariant: the solution is SuperLU's to
 1e-10, the residual check passes, the inertia is that of the stable state; the files and the
 process's environment are left as they were.
 
@@ -8,7 +8,7 @@ Each check runs in a fresh interpreter: a process holds one out-of-core solver, 
 layer, and no in-core PARDISO solver (graspdef.solve.sparse.require_one_ooc_handle and
 require_sequential_mkl: a second out-of-core handle corrupted memory, and MKL's threads gave a
 wrong out-of-core factor on a busy machine, together about 1 in 75 runs of this file until
-2026-11-27; README, "Out of core").  Those interpreters end with os._exit once their answer is
+2026-11-27; docs/speed.md, "Out of core").  Those interpreters end with os._exit once their answer is
 printed, as ``graspdef solve`` does after an out-of-core solve (graspdef.cli.console).
 
 The references are SuperLU's.  The right-hand sides are the plate's own load (a centre point
@@ -33,7 +33,7 @@ needs_pardiso = pytest.mark.skipif(not pardiso_available(), reason="PARDISO (pyp
 #: Python object overwritten, a wrong "completed" answer; then (2026-11-27, ninth session, MKL on its
 #: sequential layer, one handle) 4 failures in 2,941 out-of-core processes, these tests' and standalone
 #: ones: memory corruption in MKL's out-of-core mode, cause not found; not in `make test` until it is
-#: (README, "Out of core"); `make test-ooc` runs them
+#: (docs/speed.md, "Out of core"); `make test-ooc` runs them
 OOC_CLI = pytest.mark.ooc_cli
 
 PRELUDE = """
