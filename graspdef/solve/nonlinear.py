@@ -190,20 +190,24 @@ class PathOptions:
         0.58 and 0.92 on steps that jumped over one unnoticed.  Not applied to the first step
         nor to the first after a jump (no curvature term to go with them); 0: no check
     predictor : the first iterate of a load-controlled step (:func:`extrapolate`) --
-        "quadratic" (the default): the tangent du/dlam plus the curvature of the last step (u(lam)
-        through the last two points with the tangent at the last); "linear": the tangent alone;
-        "cubic": the Hermite cubic through the last two points with the tangents at both, on a
-        plain stretch of the path (not towards a limit point nor past a jumped one) and where its
-        cubic term is smaller than its quadratic one, else the quadratic.  Measured against
-        "quadratic" (factorisations of the path, 2026-11-28, seventeenth session, 405bbc4): fewer on
-        smooth paths -- the 10k ball's pinch 19 against 22 (8 path points against 10; 10.3 against
-        11.6 s), the 32-ring hemisphere (benchmarks/nonlinear) 46 against 71, the slit annular
-        plate 169 against 241 -- but more on the displacement-controlled pinched cylinders, whose
-        post-snap stretch crosses a train of bifurcations (48 x 48: 220 against 200; neo-Hookean
-        186 against 155; 192 x 96: 220 against 177, 509 against 459 s), so not the default.  Where the contact
-        set changes from step to step (graspdef's finger-contact paths) u(lam) has a kink at each
-        change and the curvature term overshoots: on the tennis ball's pads the linear predictor
-        needs 45 factorisations instead of 54 for the same equilibria (to 1e-10)
+        "cubic" (the default since 2026-11-28, eighteenth session): the Hermite cubic through the
+        last two points with the tangents at both, on a plain stretch of the path (not towards a
+        limit point nor past a jumped one) and where its cubic term is smaller than its quadratic
+        one, else the quadratic; "quadratic" (the default before): the tangent du/dlam plus the
+        curvature of the last step (u(lam) through the last two points with the tangent at the
+        last); "linear": the tangent alone.  Factorisations of whole paths, cubic against quadratic
+        (710ca72, one run each; counts do not depend on the machine's load): the 10k ball's pinch 19
+        against 21 (10.3 against 12.3 s), the 32-ring hemispheres 47 / 59 against 68 / 71, the slit
+        annular plate 163 against 213, the cantilevers 67 / 31 against 82 / 37, the neo-Hookean
+        pull-out 73 against 83, the 192 x 96 pinched cylinder 202 against 268; more on the SVK
+        pull-out (96 against 93), the hinged roof (17 against 16) and the neo-Hookean 48 x 48
+        pinched cylinder (166 against 144); the same on the 48 x 48 (194).  The displacement-
+        controlled pinched cylinders cross trains of bifurcations after their snap, where the count
+        follows the iterates' last bits (the 192 x 96's quadratic path took 177 before the Anderson
+        safeguard, ANDERSON_GROWTH, and 268 with it; the cubic 220 and 202): README, "Solvers".
+        Where the contact set changes from step to step (graspdef's finger-contact paths) u(lam)
+        has a kink at each change and the curvature term overshoots: on the tennis ball's pads the
+        linear predictor needs 45 factorisations instead of 54 for the same equilibria (to 1e-10)
     limit_points : what load control does where its steps stall (halved below ``min_step``) at
         a limit point of the load -- "jump" (the default): snap, as the loaded structure does,
         to the equilibrium that the smallest jumping step reached (or, if every attempt failed,
@@ -239,7 +243,7 @@ class PathOptions:
     krylov_rtol: float = 1e-2
     jump_ratio: float = 0.3
     limit_points: str = "jump"
-    predictor: str = "quadratic"
+    predictor: str = "cubic"
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
