@@ -204,7 +204,10 @@ class PathOptions:
         pinched cylinder (166 against 144); the same on the 48 x 48 (194).  The displacement-
         controlled pinched cylinders cross trains of bifurcations after their snap, where the count
         follows the iterates' last bits (the 192 x 96's quadratic path took 177 before the Anderson
-        safeguard, ANDERSON_GROWTH, and 268 with it; the cubic 220 and 202): README, "Solvers".
+        safeguard, ANDERSON_GROWTH, and 268 with it; the cubic 220 and 202; with graspdef bench's
+        step cap, max_step = max_load / steps: 48 x 48 195 against 202, neo-Hookean 319 against
+        336, pull-outs 95 / 84 against 103 / 91, 192 x 96 262 against 237): docs/speed.md,
+        "Eighteenth session".
         Where the contact set changes from step to step (graspdef's finger-contact paths) u(lam)
         has a kink at each change and the curvature term overshoots: on the tennis ball's pads the
         linear predictor needs 45 factorisations instead of 54 for the same equilibria (to 1e-10)
