@@ -197,7 +197,7 @@ class PathOptions:
         curvature of the last step (u(lam) through the last two points with the tangent at the
         last); "linear": the tangent alone.  Factorisations of whole paths, cubic against quadratic
         (710ca72, one run each; counts do not depend on the machine's load): the 10k ball's pinch 19
-        against 21 (10.3 against 12.3 s), the 32-ring hemispheres 47 / 59 against 68 / 71, the slit
+        against 21 (11.9 against 13.0 s in one hour's alternating runs), the 32-ring hemispheres 47 / 59 against 68 / 71, the slit
         annular plate 163 against 213, the cantilevers 67 / 31 against 82 / 37, the neo-Hookean
         pull-out 73 against 83, the 192 x 96 pinched cylinder 202 against 268; more on the SVK
         pull-out (96 against 93), the hinged roof (17 against 16) and the neo-Hookean 48 x 48
