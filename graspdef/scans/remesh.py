@@ -344,6 +344,15 @@ def mid_surface(outer: TriMesh, thickness: float) -> TriMesh:
         raise MeshError(f"mid-surface offset by {t / 2 * 1e3:.3g} mm turns the surface inside "
                         "out (half the thickness exceeds the object's radius)")
     if flipped.size:
+        # where: the shortest edge of the flipped faces (its midpoint) -- a feature that small (a scan's tiny
+        # fold or handle, which remeshing keeps to keep the topology) decides it
+        tri = outer.vertices[outer.faces[flipped]]
+        lengths = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2)      # edge i: corners i, i - 1
+        k, i = np.unravel_index(int(np.argmin(lengths)), lengths.shape)
+        edge = lengths[k, i]
+        at = ", ".join(f"{c * 1e3:.1f}" for c in 0.5 * (tri[k, i] + tri[k, i - 1]))
         raise MeshError(f"mid-surface offset by {t / 2 * 1e3:.3g} mm flips {flipped.size} faces "
-                        "(half the thickness exceeds the local radius of curvature)")
+                        f"(half the thickness exceeds the local radius of curvature), e.g. at ({at}) mm, "
+                        f"where the control mesh has an edge of {edge * 1e3:.3g} mm: a fold or small "
+                        "handle of the surface there")
     return mid

@@ -1,4 +1,6 @@
 """Scan -> control mesh (checked watertight manifold result) and the shell mid-surface."""
+import re
+
 import numpy as np
 import pytest
 import trimesh
@@ -133,6 +135,25 @@ def test_mid_surface_refusals():
     with pytest.raises(MeshError, match="normals point inward"):
         mid_surface(inside_out, 1e-3)
     assert is_closed(sphere.faces)
+
+
+def test_mid_surface_names_where_a_face_flips():
+    """A 10 mm cube with one edge chamfered 0.05 mm wide (a feature far below the offset, as a
+    scan's tiny fold or handle is): the refusal names the chamfer's place and its edge, in mm."""
+    L, w = 10e-3, 0.05e-3
+    pts = [[x, y, z] for x in (0, L) for y in (0, L) for z in (0, L) if not (y == L and z == L)]
+    pts += [[x, L - w, L] for x in (0, L)] + [[x, L, L - w] for x in (0, L)]
+    hull = trimesh.convex.convex_hull(np.array(pts))
+    cube = TriMesh(np.asarray(hull.vertices, float), np.asarray(hull.faces))
+    mid_surface(cube, 0.05e-3)                      # an offset below the chamfer: no flip
+    with pytest.raises(MeshError) as err:
+        mid_surface(cube, 1e-3)
+    msg = str(err.value)
+    m = re.search(r"flips (\d+) faces .* at \(([-\d.]+), ([-\d.]+), ([-\d.]+)\) mm, .* an edge of ([\d.]+) mm", msg)
+    assert m, msg
+    at = np.array([float(m.group(i)) for i in (2, 3, 4)]) * 1e-3
+    assert abs(at[1] - L) < 0.1e-3 and abs(at[2] - L) < 0.1e-3      # on the chamfered edge (y = z = L)
+    np.testing.assert_allclose(float(m.group(5)), w * np.sqrt(2) * 1e3, rtol=1e-2)   # the chamfer's width
 
 
 def test_normals_angles_and_volume_are_trimeshs(ball):
