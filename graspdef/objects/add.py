@@ -34,7 +34,7 @@ from ..errors import ProblemError
 from ..geometry import TriMesh
 from ..geometry.io import save_ply
 from ..geometry.mass import shell_inertia
-from ..geometry.mesh import vertex_valence
+from ..geometry.mesh import unique_edges, vertex_valence
 from ..runs.folder import atomic_folder
 from ..scans import control_mesh, mid_surface, ply_units, read_surface
 from ..scans.repair import repair_surface
@@ -72,12 +72,25 @@ class AddedObject:
             f"  control mesh: {cm['n_vertices']} vertices, {cm['n_faces']} faces (isotropic remeshing); smallest "
             f"angle {cm['min_angle_deg']:.1f} deg; valences {hist}; Hausdorff distance to the input "
             f"{cm['hausdorff_m'] * 1e3:.2f} mm (rms {cm['input_to_mesh_rms_m'] * 1e3:.2f} mm)",
+            *_topology(cm),
             f"  shell: thickness {r['thickness_m'] * 1e3:.4g} mm, mass {r['mass_kg'] * 1e3:.4g} g; collision: "
             f"{r['collision']}",
             f"  grasp: {g['how']}, {g['width_m'] * 1e3:.1f} mm wide, antipodal within {g['antipodal_angle_deg']:.1f} "
             f"deg; gripper force range 0..{r['gripper_force_max_N']:g} N per finger",
             f"  memory estimate of a nonlinear solve: {r['memory_estimate_bytes'] / 2**30:.2f} GiB",
         ]
+
+
+def _topology(cm: dict) -> list[str]:
+    """The summary's line on handles, if the surface has any (a closed surface of genus g has g)."""
+    g = cm.get("genus", 0)
+    if not g:
+        return []
+    small = cm["shortest_edge_m"] < 0.1 * cm["median_edge_m"]
+    return [f"  topology: genus {g} (Euler characteristic {cm['euler']}): {g} handle{'s' if g > 1 else ''} kept "
+            f"from the input; shortest control-mesh edge {cm['shortest_edge_m'] * 1e3:.2g} mm (median "
+            f"{cm['median_edge_m'] * 1e3:.2g} mm)" + ("; handles this small are usually scan noise, and they bound the "
+                                                         "wall thickness the mid-surface allows" if small else "")]
 
 
 def _units(path: Path, units: str, vertices: np.ndarray) -> tuple[str, str]:
@@ -230,6 +243,7 @@ def add_object(name: str, mesh, out, *, thickness: float, material: MaterialSpec
     check_thin_shell(thickness, outer.vertices, "--thickness")
     mid_surface(outer, thickness)                                 # the offset must not fold the surface
     need = check_memory(outer.n_vertices, f"a control mesh of {outer.n_faces} faces")
+    lengths = np.linalg.norm(np.diff(outer.vertices[unique_edges(outer.faces)], axis=1)[:, 0], axis=1)
     haus, rms = _hausdorff(repaired.mesh, outer)
     val = vertex_valence(outer.faces, outer.n_vertices)
     area = float(trimesh.Trimesh(outer.vertices, outer.faces, process=False).area)
@@ -252,7 +266,9 @@ def add_object(name: str, mesh, out, *, thickness: float, material: MaterialSpec
         "control_mesh": {"method": rep.method, "n_vertices": rep.n_vertices, "n_faces": rep.n_faces,
                          "euler": rep.euler, "min_angle_deg": rep.min_angle_deg,
                          "valence_histogram": {int(k): int(c) for k, c in enumerate(np.bincount(val)) if c},
-                         "hausdorff_m": haus, "input_to_mesh_rms_m": rms, "volume_m3": rep.volume},
+                         "hausdorff_m": haus, "input_to_mesh_rms_m": rms, "volume_m3": rep.volume,
+                         "genus": (2 - rep.euler) // 2, "shortest_edge_m": float(lengths.min()),
+                         "median_edge_m": float(np.median(lengths))},
         "thickness_m": float(thickness), "thickness_source": thickness_source or "given to graspdef object add",
         "mass_kg": m, "mass_from": "density" if density is not None else "mass", "centre_of_mass_m": com.tolist(),
         "inertia_kg_m2": inertia.tolist(), "friction": float(friction), "collision": how,

@@ -146,6 +146,7 @@ def test_add_a_sphere(tmp_path):
     assert r["collision"].startswith("convex hull")
     assert r["grasp"]["width_m"] == pytest.approx(0.06, rel=0.01) and r["grasp"]["antipodal_angle_deg"] < 3
     assert done.folder == tmp_path / "ball"
+    assert r["control_mesh"]["genus"] == 0 and not any("topology" in line for line in done.summary())
     from graspdef.objects import load_object
 
     spec = load_object(tmp_path / "ball")
@@ -153,3 +154,18 @@ def test_add_a_sphere(tmp_path):
     assert spec.material.shell_material("nonlinear").__class__.__name__ == "CompressibleNeoHookean"
     with pytest.raises(GraspdefError, match="not empty"):
         add_object("ball", tmp_path / "ball.stl", tmp_path / "ball", thickness=2e-3, material=mat, density=1100.0)
+
+
+def test_add_a_torus_reports_its_handle(tmp_path):
+    """A torus (R 30 mm, r 10 mm) keeps its one handle through the remeshing: genus 1 (Euler
+    characteristic 0) in the record and a summary line with the shortest and median edges [mm]."""
+    trimesh.creation.torus(30.0, 10.0).export(tmp_path / "ring.stl")
+    mat = MaterialSpec("neo_hookean", 2e6, 0.45, None, "test")
+    done = add_object("ring", tmp_path / "ring.stl", tmp_path / "ring", thickness=2e-3, material=mat,
+                      density=1100.0, faces=1500)
+    cm = done.record["control_mesh"]
+    assert (cm["euler"], cm["genus"]) == (0, 1)
+    assert 0 < cm["shortest_edge_m"] <= cm["median_edge_m"] < 0.01
+    line = [x for x in done.summary() if "topology" in x]
+    assert len(line) == 1 and "genus 1 (Euler characteristic 0): 1 handle kept" in line[0]
+    assert "scan noise" not in line[0]          # its edges are all of one size (2.6 and 4.3 mm measured)
