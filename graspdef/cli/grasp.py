@@ -132,5 +132,10 @@ def run(a: argparse.Namespace) -> int:
     print(f"run folder: {run.out}")
     for w in r.get("warnings", []):
         warn(w)
+    if not conv["completed"]:
+        # the summary's figures are those of the last equilibrium: say how much of the force that is, and why
+        lf = float(conv.get("load_factor", 0.0))
+        warn(f"the results are at load factor {lf:.3g} of the {r['force_N']:g} N per finger asked "
+             f"({lf * r['force_N']:.3g} N): {conv.get('stop_reason') or 'the path stopped (no reason recorded)'}")
     progress(a, f"look at it: graspdef report {run.out}, or graspdef view {run.out}")
     return 0

@@ -86,3 +86,25 @@ def test_stages_alone_and_the_equilibrium_warning():
     setup.residual_F = setup.residual_F + np.array([1.0, 0.0, 0.0])
     bad = gp.grasp_record(obj, st, setup, solved, 5.0, "point", "linear", {})
     assert [w for w in bad.record["warnings"] if "not in equilibrium: net force 1 N" in w], bad.record["warnings"]
+
+
+def test_a_stopped_path_says_how_much_force_and_why(monkeypatch, tmp_path, capsys):
+    """A grasp whose load path stops short (e.g. a soft shell snapping under point loads) exits 0
+    with its last equilibrium, and says on one warning line which fraction of the force that is,
+    in newtons per finger, and the path's own stop reason."""
+    from types import SimpleNamespace
+
+    import graspdef.pipeline.grasp as gp
+
+    result = {"object": "duck", "analysis": "nonlinear", "contact": "point", "force_N": 40.0,
+              "derived": {"indentation_per_finger": {"label": "indentation per finger", "value": 0.01318},
+                          "max_displacement": {"label": "max. displacement", "value": 0.01346}},
+              "convergence": {"completed": False, "load_factor": 0.03125,
+                              "stop_reason": "the load path stopped at load factor 0.03125 after 3 steps: "
+                                             "a limit point of the load"},
+              "timings_s": {"total": 7.3}, "warnings": []}
+    monkeypatch.setattr(gp, "run_grasp", lambda *a, **k: SimpleNamespace(result=result, out=tmp_path / "run"))
+    assert grasp_cli(["tennis_ball", "--force", "40", "--out", str(tmp_path / "run")]) == 0
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if "load factor 0.0312 of the 40 N per finger asked (1.25 N)" in ln]
+    assert len(lines) == 1 and lines[0].endswith("a limit point of the load")
