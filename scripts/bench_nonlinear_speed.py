@@ -82,6 +82,8 @@ print(json.dumps({"n_control": int(shell.mesh.n_real), "import_s": t_imp - t0, "
                   # calls (a block of right-hand sides is one call); code before blocks: each was one
                   "back_calls": getattr(sol, "n_back_calls", getattr(sol, "n_back_substitutions", None)),
                   "inexact_steps": getattr(sol, "n_inexact", None), "gmres_iterations": getattr(sol, "n_krylov", None),
+                  # local corrections (PathOptions.local_rings; code before them: None)
+                  "local_steps": getattr(sol, "n_local", None),
                   "factor_s": sol.timings["factor"], "solve_s": sol.timings["solve"],
                   "top_displacement_mm": float(-sol.probe("top")[2] * 1e3),
                   "stable": [p.stable for p in sol.path]}))
@@ -108,6 +110,7 @@ def _show(label: str, k: int, r: dict) -> None:
           f"Newton iterations {r['newton_iterations']}, "
           + (f"{r['hessians']} Hessians, {r['back_substitutions']} back-substitutions in {r.get('back_calls')} calls, {r['inexact_steps']} inexact "
              f"Newton steps ({r['gmres_iterations']} GMRES iterations), " if r.get("hessians") is not None else "")
+          + (f"{r['local_steps']} local corrections, " if r.get("local_steps") is not None else "")
           + f"pole displacement {r['top_displacement_mm']:.2f} mm", flush=True)
 
 

@@ -58,7 +58,7 @@ _SOLVER = {"backend": "str", "precision": "str", "collocation": "int", "nitsche_
            "line_search": "bool",
            "max_probe_displacement": "length", "refine_critical": "int",
            "reuse_factorisation": "bool", "reuse_ratio": "float", "anderson": "int", "inertia_rtol": "float",
-           "krylov": "int", "krylov_rtol": "float", "jump_ratio": "float", "limit_points": "str",
+           "krylov": "int", "krylov_rtol": "float", "local_rings": "int", "jump_ratio": "float", "limit_points": "str",
            "bifurcation": "str", "predictor": "str"}
 _LENGTH_KEYS = {"lx", "ly", "center", "a", "b", "c", "radius", "length", "half_width", "scale", "r_inner", "r_outer",
                 "edge_length", "rise"}

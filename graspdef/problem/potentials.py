@@ -80,6 +80,9 @@ class FollowerPressure(TermBase):
         V, g, H = self._vol.hessian(x, scale=-lam * self.p)
         return PotentialTerms(-lam * self.p * V, -lam * self.p * g, H)
 
+    def hessian_rows(self, x: np.ndarray, lam: float, region) -> tuple:
+        return region.volume.hessian(x, scale=-lam * self.p)[2], []
+
     def load(self, x: np.ndarray) -> np.ndarray:
         return self.p * self._vol.gradient(x)[1]
 
@@ -135,6 +138,11 @@ class EnclosedGas(TermBase):
         H.data *= -pg
         c = (self.p_atm + self.p0) * self.V0 / V ** 2
         return PotentialTerms(self._value(V), -pg * g, H, [(c, g)])
+
+    def hessian_rows(self, x: np.ndarray, lam: float, region) -> tuple:
+        V, g = self._vol.gradient(x)                    # the pressure and the rank-one part are the whole volume's
+        H = region.volume.hessian(x, scale=-self.gauge_pressure(V))[2]
+        return H, [((self.p_atm + self.p0) * self.V0 / V ** 2, g)]
 
     def load(self, x: np.ndarray) -> np.ndarray:
         return np.zeros(3 * len(x))

@@ -14,6 +14,10 @@ Each term is set up completely when it is built (from a shell, by its specificat
 * ``record(x)``: numbers for the path record (e.g. the enclosed gas's volume and pressure);
 * ``internal``: True for the shell's own (elastic and support) forces, which set the force scale
   of the convergence test;
+* ``hessian_rows(x, lam, region)`` (optional): the rows of the Hessian at the control vertices of a
+  :class:`graspdef.shell.region.Region` -- a CSR matrix (3|R|, 3n) on the region's pattern, or None
+  where the term has no Hessian -- and the term's rank-one parts [(c, v)] (v whole); computed on
+  the region's faces only, for the path's local corrections (a term without it turns them off);
 * ``remedy`` (optional, None by default): for a term that is not convex by itself -- e.g. a Nitsche
   edge term, whose consistency part is bounded only by its penalty -- a sentence naming the
   setting that restores it; a path that stalls on a mode that such a term makes soft says so
@@ -74,6 +78,10 @@ class TermBase:
         return {}
 
 
+#: ``hessian_rows`` of a term without a Hessian (dead loads): no rows, no rank-one parts
+NO_ROWS = (None, [])
+
+
 class ShellElastic(TermBase):
     """The shell's membrane + bending energy at finite deformation (graspdef.shell.energy)."""
 
@@ -90,6 +98,9 @@ class ShellElastic(TermBase):
         if order == 1:
             return TermValue(*self.energy.gradient(x), None)
         return TermValue(*self.energy.hessian(x))
+
+    def hessian_rows(self, x: np.ndarray, lam: float, region) -> tuple:
+        return region.energy.hessian(x)[2], []
 
 
 class RestQuadratic(TermBase):
@@ -109,6 +120,9 @@ class RestQuadratic(TermBase):
         g = self.K @ u
         E = 0.5 * float(u @ g)
         return TermValue(E, None if order == 0 else g, self.K if order == 2 else None)
+
+    def hessian_rows(self, x: np.ndarray, lam: float, region) -> tuple:
+        return self.K[region.dofs], []
 
 
 class NitscheTerm(TermBase):
@@ -137,6 +151,9 @@ class DeadLoads(TermBase):
     def evaluate(self, x: np.ndarray, lam: float, order: int = 2, u: np.ndarray | None = None) -> TermValue:
         u = (x - self.X).ravel() if u is None else u
         return TermValue(-lam * float(self.f @ u), None if order == 0 else -lam * self.f, None)
+
+    def hessian_rows(self, x: np.ndarray, lam: float, region) -> tuple:
+        return NO_ROWS
 
     def load(self, x: np.ndarray) -> np.ndarray:
         return self.f.copy()

@@ -63,6 +63,12 @@ def _refuse_load_control_options(names) -> None:
 NEWTON_FORCING = 0.1
 #: ... and of one on a reused (earlier) tangent, which contracts the residual by ~0.01-0.9 per step
 STALE_FORCING = 1e-3
+#: Halvings of a local correction's step (PathOptions.local_rings) whose energy does not decrease,
+#: before the tangent is factorised at that iterate instead
+LOCAL_BACKTRACKS = 4
+#: ... and the factor by which its rings grow, once per Newton solve, when a local correction's step
+#: does not contract by ``reuse_ratio``
+LOCAL_GROWTH = 2
 
 #: First Newton iteration at which a residual grown tenfold over the first iterate's ends the
 #: attempt (PathSolver.newton).  Measured over 19 load-controlled paths of the nonlinear benchmark
@@ -173,6 +179,13 @@ class PathOptions:
         cylinder, 229 -> 261 factorisations); see :meth:`PathSolver.newton`
     inertia_rtol : the stability of a point is the inertia of a Hessian factorised within this
         relative residual of it (0: at the converged state itself); see :meth:`PathSolver.newton`
+    local_rings : local corrections on a reused tangent (0: none): the Newton steps on the previous
+        point's factorisation are each preceded by an exact Newton step in the region where the
+        first iterate's residual sits (the fewest control vertices holding 99 % of its square, grown
+        by this many rings of the control mesh; :meth:`Equilibrium.local_step`), as long as they
+        contract by ``reuse_ratio``; only where every energy term gives its Hessian's rows
+        (``hessian_rows``: the shell, dead and point loads, pressure, enclosed gas) and the region
+        holds at most a quarter of the control vertices; see :meth:`PathSolver.newton`
     bifurcation : what a load-controlled path does at a change of stability that is not a limit
         point -- "report" (the bracket of the two path points), "locate" (bisect the load step
         ``refine_critical`` times: the bracket shrinks by 2^-refine_critical) or "switch" (locate,
@@ -242,6 +255,7 @@ class PathOptions:
     reuse_ratio: float = 0.9
     anderson: int = 5
     inertia_rtol: float = 1e-4
+    local_rings: int = 5
     krylov: int = 0
     krylov_rtol: float = 1e-2
     jump_ratio: float = 0.3
@@ -280,6 +294,8 @@ class PathOptions:
             raise ProblemError(f"inertia_rtol must lie in [0, 1e-2), got {self.inertia_rtol!r}")
         if not isinstance(self.krylov, (int, np.integer)) or self.krylov < 0:
             raise ProblemError(f"krylov must be a non-negative integer, got {self.krylov!r}")
+        if not isinstance(self.local_rings, (int, np.integer)) or isinstance(self.local_rings, bool) or self.local_rings < 0:
+            raise ProblemError(f"local_rings must be a non-negative integer, got {self.local_rings!r}")
         if not (0 < self.krylov_rtol < 1):
             raise ProblemError(f"krylov_rtol must lie in (0, 1), got {self.krylov_rtol!r}")
         if not (0 < self.reuse_ratio < 1):
@@ -348,6 +364,7 @@ class NonlinearSolution(DisplacementField):
         n_back_calls : back-substitution calls (a block of right-hand sides in one call costs about
         what one column does, graspdef.solve.sparse.KKTSystem.certify_inertia_along);
         n_krylov : GMRES iterations of inexact Newton steps;  n_inexact : inexact Newton steps;
+        n_local : Newton steps with a local correction (``PathOptions.local_rings``);
         n_single : of the factorisations, single-precision ones (``precision`` "mixed", or "auto"
         from 20,000 unknowns; the rest double);  n_certificates : inertias of single-precision
         factors certified (graspdef.solve.sparse.KKTSystem.certify_inertia)
@@ -367,6 +384,7 @@ class NonlinearSolution(DisplacementField):
     n_back_calls: int = 0
     n_krylov: int = 0
     n_inexact: int = 0
+    n_local: int = 0
     n_single: int = 0
     n_certificates: int = 0
 
@@ -570,6 +588,18 @@ class PathSolver:
         eta = None                  # forcing term of the last inexact step
         exact = False               # the last step was on a tangent factorised at its iterate
         far = False                 # a step on a fresh tangent did not contract: no inexact steps
+        local = None                # the region of local corrections on the reused tangent (local_rings)
+        local_tried = not opt.local_rings
+        local_grown = False         # the region was grown once (LOCAL_GROWTH)
+
+        def grow(st):
+            """A region of LOCAL_GROWTH times the rings around the residual at this iterate (once)."""
+            nonlocal local, local_grown
+            local_grown = True
+            wider = eq.local_region(eq.projected_residual(st.gradient)[0], LOCAL_GROWTH * opt.local_rings)
+            if wider is not None:
+                local = wider
+            return wider is not None
         self.last_step = np.inf
 
         def ahead(st, cres):
@@ -608,7 +638,7 @@ class PathSolver:
             within ``krylov`` iterations (to krylov_rtol if ``tight``), else on a fresh
             factorisation (which gives the stability if within inertia_rtol, unless ``keep_near``:
             the line search's refresh, which never did); returns (state, du, exact)."""
-            nonlocal near, hist, inexact, eta
+            nonlocal near, hist, inexact, eta, local
             if opt.krylov and near is None and not far:
                 # forcing term (Eisenstat & Walker 1996, choice 2): loose while Newton itself
                 # contracts slowly, down to krylov_rtol as it reaches its quadratic rate
@@ -627,6 +657,7 @@ class PathSolver:
                 st = eq.evaluate(u, lam, 2)
             stab = not keep_near and rel <= opt.inertia_rtol
             rhs = ahead(st, cres) if stab else None
+            local = None
             inst = eq.factor(st, inertia=stab, ahead=rhs)
             if not keep_near:
                 near = (inst, rel) if rel <= opt.inertia_rtol else None
@@ -676,6 +707,10 @@ class PathSolver:
                 if st.hessian is None:
                     st = eq.evaluate(u, lam, 2)
                 need_h = True
+            elif not need_h and poor and local is not None and not local_grown and grow(st):
+                # a local correction that did not contract: the tangent changed beyond its region;
+                # once per solve, a region of LOCAL_GROWTH times the rings around where the residual is now
+                hist = []
             elif not need_h and (inexact or poor):
                 # poor contraction of the reused tangent: this iterate's tangent, by GMRES if it can
                 # (to krylov_rtol if a looser inexact step did not contract)
@@ -686,9 +721,24 @@ class PathSolver:
                 rhs = ahead(st, cres) if rel <= opt.inertia_rtol else None
                 inst = eq.factor(st, inertia=rel <= opt.inertia_rtol, ahead=rhs)
                 near = (inst, rel) if rel <= opt.inertia_rtol else None
-                hist, inexact = [], False
+                hist, inexact, local = [], False, None
+            stepped_local = False         # du is a local correction's step (Equilibrium.local_step)
             if not fresh:
-                du = direction(st, cres, fresh=need_h, stability=rhs)
+                du = None
+                if not need_h and near is None and not inexact:
+                    if not local_tried:
+                        # the first step on the reused tangent: where does its residual sit?
+                        local_tried = True
+                        local = eq.local_region(eq.projected_residual(st.gradient)[0], opt.local_rings)
+                    if local is not None:
+                        gn = max(float(np.linalg.norm(st.gradient)), 1e-300)
+                        du = eq.local_step(u, lam, st, cres, local, rtol=min(0.1, max(
+                            1e-8, STALE_FORCING * self.residual_norm / gn)) if eq.kkt.single else 1e-8)
+                        if du is None:
+                            local = None
+                        stepped_local = du is not None
+                if du is None:
+                    du = direction(st, cres, fresh=need_h, stability=rhs)
             # the supports hold to solve precision: the step need not restore them, and the energy
             # is a merit function along it
             feasible = float(np.linalg.norm(cres)) <= 1e-8 * max(float(np.linalg.norm(u)), float(np.linalg.norm(du)),
@@ -712,11 +762,22 @@ class PathSolver:
                 if slope < 0 and -slope > 1e-10 * abs(st.energy):
                     e_new = eq.energy(u + du, lam)
                     if not (need_h or fresh) and not (np.isfinite(e_new) and e_new <= st.energy + 1e-4 * slope):
-                        # a reused tangent whose step does not decrease the energy: this iterate's
-                        # tangent (by GMRES if it can, else factorised here)
-                        st, du, need_h = refresh(u, st, cres, keep_near=True)
-                        slope = float(st.gradient @ du)
-                        e_new = eq.energy(u + du, lam)
+                        if stepped_local:
+                            # a local correction's step that overshoots (the dimple's stiffness
+                            # changes fast): back-tracked first
+                            for _ in range(LOCAL_BACKTRACKS):
+                                alpha *= 0.5
+                                e_new = eq.energy(u + alpha * du, lam)
+                                if np.isfinite(e_new) and e_new <= st.energy + 1e-4 * alpha * slope:
+                                    break
+                            else:
+                                alpha, local = 1.0, None
+                        if not stepped_local or local is None:
+                            # a reused tangent whose step does not decrease the energy: this iterate's
+                            # tangent (by GMRES if it can, else factorised here)
+                            st, du, need_h = refresh(u, st, cres, keep_near=True)
+                            slope = float(st.gradient @ du)
+                            e_new = eq.energy(u + du, lam)
                     for _ in range(8):
                         if np.isfinite(e_new) and e_new <= st.energy + 1e-4 * alpha * slope:
                             break
@@ -725,11 +786,14 @@ class PathSolver:
                     else:
                         alpha = 1.0                      # no decrease found: plain Newton step
                 step = alpha * du
-            if feasible and opt.reuse_factorisation and not inexact:
+            if feasible and opt.reuse_factorisation and not inexact and not stepped_local:
+                # (a local correction's step is not mixed: on the 10k ball's pinch, mixed, the path's
+                # longest step stalled and took 4 factorisations instead of 1)
                 hist = ([(u, du)] + hist)[: opt.anderson]
             log.debug("  newton it %d lam %.6g rel %.2e (floor %.2e) alpha %.3g |du| %.3e tangent %s%s", it, lam, rel, self.residual[1], alpha,
                       float(np.linalg.norm(du)),
-                      "new" if need_h else f"inexact ({eq.last_krylov} GMRES, eta {eta:.1e})" if inexact else "reused",
+                      "new" if need_h else f"inexact ({eq.last_krylov} GMRES, eta {eta:.1e})" if inexact else
+                      "reused, local correction" if stepped_local else "reused",
                       f" (Anderson {len(hist) - 1})" if len(hist) > 1 else "")
             u = u + step
             prev = rel
@@ -850,6 +914,7 @@ class PathSolver:
         sol.n_certificates = self.eq.kkt.certificates
         sol.n_krylov = self.eq.n_krylov
         sol.n_inexact = self.n_inexact
+        sol.n_local = self.eq.n_local
         sol.completed = sol.stop_reason is None
         self._detect(sol)
         self._classify(sol)
