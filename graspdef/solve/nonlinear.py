@@ -416,10 +416,11 @@ class NonlinearSolution(DisplacementField):
     def convergence(self) -> dict:
         """How the path went, JSON-ready, for the run records (``graspdef solve``, grasps, patch
         models): the last load factor, the points, Newton iterations per point, factorisations,
-        the ``events`` (every attempt cut, every bracket not narrowed, in words) and the
+        the Newton steps with a local correction (``PathOptions.local_rings``), the ``events`` (every attempt cut, every bracket not narrowed, in words) and the
         ``critical_points`` (their probes as lists)."""
         return {"load_factor": self.load_factor, "n_points": len(self.path), "newton_iterations": self.iterations(),
                 "n_factorisations": self.n_factorisations, "n_single_precision_factorisations": self.n_single,
+                "n_local_corrections": self.n_local,
                 "events": [dict(e) for e in self.events],
                 "critical_points": [dict(cp, probes={k: np.asarray(v).tolist() for k, v in cp["probes"].items()})
                                     for cp in self.critical_points]}

@@ -154,6 +154,7 @@ def test_a_pinch_with_local_corrections_reaches_the_same_equilibria_with_fewer_f
         assert sol.completed and all(p.stable for p in sol.path)
         runs[rings] = sol
     assert runs[0].n_local == 0 < runs[5].n_local
+    assert runs[5].convergence()["n_local_corrections"] == runs[5].n_local
     assert runs[5].n_factorisations < runs[0].n_factorisations
     assert np.allclose(runs[5].probe("top"), runs[0].probe("top"), rtol=0, atol=1e-8 * np.linalg.norm(runs[0].probe("top")))
 
