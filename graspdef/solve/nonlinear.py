@@ -416,8 +416,9 @@ class NonlinearSolution(DisplacementField):
     def convergence(self) -> dict:
         """How the path went, JSON-ready, for the run records (``graspdef solve``, grasps, patch
         models): the last load factor, the points, Newton iterations per point, factorisations,
-        the Newton steps with a local correction (``PathOptions.local_rings``), the ``events`` (every attempt cut, every bracket not narrowed, in words) and the
-        ``critical_points`` (their probes as lists)."""
+        the Newton steps with a local correction (``PathOptions.local_rings``), the ``events``
+        (every attempt cut, every bracket not narrowed, in words) and the ``critical_points``
+        (their probes as lists)."""
         return {"load_factor": self.load_factor, "n_points": len(self.path), "newton_iterations": self.iterations(),
                 "n_factorisations": self.n_factorisations, "n_single_precision_factorisations": self.n_single,
                 "n_local_corrections": self.n_local,
@@ -577,7 +578,19 @@ class PathSolver:
         solution: the inexact steps would only repeat what the exact one failed to do), this solve
         takes no more inexact steps (the 891-vertex slit annular plate with ``krylov`` 10: 34 -> 23 s;
         the 10k ball's path unchanged).  An inexact step never gives a stability: that comes only
-        from factorisations, as above."""
+        from factorisations, as above.
+
+        Local corrections (``local_rings`` > 0): at the first step on a reused tangent the region
+        where the residual sits is found (:meth:`Equilibrium.local_region`; none if it is not local
+        or a term gives no Hessian rows), and every step on that tangent above ``inertia_rtol`` is
+        then :meth:`Equilibrium.local_step` -- an exact Newton step in the region, with the
+        Hessian's rows there only, and the reused factorisation's step for the residual left.  Such
+        a step whose energy rises is back-tracked (``LOCAL_BACKTRACKS`` halvings) before the
+        tangent is factorised instead; one that does not contract by ``reuse_ratio`` gets, once, a
+        region of ``LOCAL_GROWTH`` times the rings; they are not Anderson-mixed; any factorisation
+        in this solve ends them.  On the 10k ball's pinch every point then reaches
+        ``inertia_rtol`` on the previous point's factorisation, and its one factorisation is its
+        stability's (19 -> 11 for the path)."""
         eq, opt = self.eq, self.opt
         u = u0.copy()
         first = prev = rn_first = None
@@ -592,6 +605,7 @@ class PathSolver:
         local = None                # the region of local corrections on the reused tangent (local_rings)
         local_tried = not opt.local_rings
         local_grown = False         # the region was grown once (LOCAL_GROWTH)
+        self.last_step = np.inf
 
         def grow(st):
             """A region of LOCAL_GROWTH times the rings around the residual at this iterate (once)."""
@@ -601,7 +615,6 @@ class PathSolver:
             if wider is not None:
                 local = wider
             return wider is not None
-        self.last_step = np.inf
 
         def ahead(st, cres):
             """The right-hand sides of ``direction``'s solve on a factorisation that gives the
