@@ -28,16 +28,22 @@ from .model import RestGroup, Shell
 from .volume import EnclosedVolume
 
 
+def _adjacency(shell: Shell) -> sp.csr_matrix:
+    """The control mesh's vertex adjacency (n, n), int8."""
+    n = shell.n_control
+    F = np.asarray(shell.mesh.faces)
+    e = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    A = sp.csr_matrix((np.ones(len(e), np.int8), (e[:, 0], e[:, 1])), shape=(n, n))
+    return ((A + A.T) > 0).astype(np.int8).tocsr()
+
+
 def vertex_rings(shell: Shell, seeds: np.ndarray, rings: int) -> np.ndarray:
     """Boolean mask of the control vertices within ``rings`` edges of the ``seeds`` (a boolean
     mask or indices) on the control mesh."""
     n = shell.n_control
     mask = np.zeros(n, bool)
     mask[seeds] = True
-    F = np.asarray(shell.mesh.faces)
-    e = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
-    A = sp.csr_matrix((np.ones(len(e), np.int8), (e[:, 0], e[:, 1])), shape=(n, n))
-    A = ((A + A.T) > 0).astype(np.int8).tocsr()
+    A = shell.derived("vertex_adjacency", lambda: _adjacency(shell))
     for _ in range(int(rings)):
         grown = mask | (A @ mask.astype(np.int8) > 0)
         if np.array_equal(grown, mask):

@@ -376,6 +376,8 @@ class Equilibrium:
             return None
         order = np.argsort(-w, kind="stable")
         k = int(np.searchsorted(np.cumsum(w[order]), share * total)) + 1
+        if k > max_share * shell.n_control:
+            return None
         mask = vertex_rings(shell, order[:k], rings) & ~self._held
         if not mask.any() or mask.sum() > max_share * shell.n_control:
             return None
@@ -400,7 +402,9 @@ class Equilibrium:
             return None
         dofs = region.dofs
         r, _ = self.projected_residual(state.gradient)
-        A = region.own_block(rows)
+        pat = region.view.block_pattern
+        A = region.own_block(rows) if (same_array(rows.indices, pat.scalar_indices)
+                                       and same_array(rows.indptr, pat.scalar_indptr)) else rows[:, dofs]
         B = np.column_stack([-r[dofs]] + [v[dofs] for _, v in rank_one])
         try:
             with np.errstate(all="raise"):
