@@ -136,13 +136,16 @@ class EnclosedGas(TermBase):
         V, g, H = self._vol.hessian(x)
         pg = self.gauge_pressure(V)
         H.data *= -pg
-        c = (self.p_atm + self.p0) * self.V0 / V ** 2
-        return PotentialTerms(self._value(V), -pg * g, H, [(c, g)])
+        return PotentialTerms(self._value(V), -pg * g, H, [(self._stiffness(V), g)])
+
+    def _stiffness(self, V: float) -> float:
+        """-dp/dV [Pa/m^3]: the coefficient of the rank-one Hessian part (dp/dV) grad V grad V^T."""
+        return (self.p_atm + self.p0) * self.V0 / V ** 2
 
     def hessian_rows(self, x: np.ndarray, lam: float, region) -> tuple:
         V, g = self._vol.gradient(x)                    # the pressure and the rank-one part are the whole volume's
         H = region.volume.hessian(x, scale=-self.gauge_pressure(V))[2]
-        return H, [((self.p_atm + self.p0) * self.V0 / V ** 2, g)]
+        return H, [(self._stiffness(V), g)]
 
     def load(self, x: np.ndarray) -> np.ndarray:
         return np.zeros(3 * len(x))

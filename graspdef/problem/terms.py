@@ -79,7 +79,7 @@ class TermBase:
 
 
 #: ``hessian_rows`` of a term without a Hessian (dead loads): no rows, no rank-one parts
-NO_ROWS = (None, [])
+NO_ROWS = (None, ())
 
 
 class ShellElastic(TermBase):

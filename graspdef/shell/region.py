@@ -107,7 +107,6 @@ class Region:
         vmask = np.asarray(vmask, bool)
         if vmask.shape != (shell.n_control,) or not vmask.any():
             raise ValueError("a region needs a non-empty boolean mask over the control vertices")
-        self.shell = shell
         self.vertices = np.flatnonzero(vmask)
         self.dofs = (3 * self.vertices[:, None] + np.arange(3)).ravel()
         groups, rest, gmasks = [], [], []

@@ -395,9 +395,7 @@ class Equilibrium:
             M, r1 = t.hessian_rows(x, lam, region)
             rank_one += r1
             if M is not None:
-                rows = M if rows is None else (
-                    sp.csr_matrix((rows.data + M.data, rows.indices, rows.indptr), shape=rows.shape)
-                    if same_array(rows.indices, M.indices) and same_array(rows.indptr, M.indptr) else rows + M)
+                rows = M if rows is None else _add(rows, M)
         if rows is None:
             return None
         dofs = region.dofs
@@ -407,15 +405,13 @@ class Equilibrium:
                                        and same_array(rows.indptr, pat.scalar_indptr)) else rows[:, dofs]
         B = np.column_stack([-r[dofs]] + [v[dofs] for _, v in rank_one])
         try:
-            with np.errstate(all="raise"):
-                Y = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A").solve(B)
-        except (RuntimeError, FloatingPointError):
+            Y = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A").solve(B)
+        except RuntimeError:                           # SuperLU: the block is exactly singular
             return None
         dR = Y[:, 0]
         if rank_one:
-            V, W = B[:, 1:], Y[:, 1:]
-            c = np.array([c for c, _ in rank_one])
-            dR = dR - W @ np.linalg.solve(np.diag(1.0 / c) + V.T @ W, V.T @ dR)
+            V, W, S = self._woodbury(B[:, 1:], np.array([c for c, _ in rank_one]), Y[:, 1:])
+            dR = dR - W @ np.linalg.solve(S, V.T @ dR)
         d = np.zeros(self.n)
         d[dofs] = dR
         g2 = state.gradient + rows.T @ dR

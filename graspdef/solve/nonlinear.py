@@ -635,9 +635,6 @@ class PathSolver:
             and this is what :func:`ahead` gave it (the load tangent is solved along, see below)."""
             if not eq.kkt.single:
                 return eq.solve(-st.gradient, cres)
-            gn = max(float(np.linalg.norm(st.gradient)), 1e-300)
-            eta_n = NEWTON_FORCING * min(rel, 0.1) if fresh else STALE_FORCING
-            rtol = max(1e-8, eta_n * self.residual_norm / gn)
             if stability is not None:
                 # the factorisation that gives the stability (just made) is, once converged, the next step's
                 # predictor: its tangent du/dlam = A^-1 q rides in this step's back-substitutions
@@ -645,7 +642,13 @@ class PathSolver:
                 both = eq.solve(*stability, exact=False)
                 self._ahead = (eq.n_factorisations, st.load.copy(), both[:, 1])
                 return both[:, 0]
-            return eq.solve(-st.gradient, cres, rtol=min(rtol, 0.1), exact=False)
+            return eq.solve(-st.gradient, cres, rtol=forcing(st, fresh), exact=False)
+
+        def forcing(st, fresh):
+            """The relative residual a single-precision factor's Newton step is solved to (``direction``)."""
+            gn = max(float(np.linalg.norm(st.gradient)), 1e-300)
+            eta_n = NEWTON_FORCING * min(rel, 0.1) if fresh else STALE_FORCING
+            return min(max(1e-8, eta_n * self.residual_norm / gn), 0.1)
 
         def refresh(u, st, cres, tight=False, keep_near=False):
             """A step on the tangent at u (``st`` its state): inexact (GMRES) if it converges
@@ -745,9 +748,8 @@ class PathSolver:
                         local_tried = True
                         local = eq.local_region(eq.projected_residual(st.gradient)[0], opt.local_rings)
                     if local is not None:
-                        gn = max(float(np.linalg.norm(st.gradient)), 1e-300)
-                        du = eq.local_step(u, lam, st, cres, local, rtol=min(0.1, max(
-                            1e-8, STALE_FORCING * self.residual_norm / gn)) if eq.kkt.single else 1e-8)
+                        du = eq.local_step(u, lam, st, cres, local,
+                                           rtol=forcing(st, False) if eq.kkt.single else 1e-8)
                         if du is None:
                             local = None
                         stepped_local = du is not None
