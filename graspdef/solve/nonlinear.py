@@ -682,8 +682,17 @@ class PathSolver:
             return st, direction(st, cres, stability=rhs), True
 
         max_it = 4 * opt.max_iterations if patient else opt.max_iterations if budget is None else budget
+        trial = None                # (alpha, state at u + alpha du) of the last step's energy test
+
+        def trial_at(a):
+            """The energy at u + a du, its state kept as ``trial`` (the next iterate's if that step is taken)."""
+            nonlocal trial
+            trial = (a, eq.evaluate(u + a * du, lam, 1))
+            return trial[1].energy
+
         for it in range(max_it + 1):
-            st = eq.evaluate(u, lam, 2 if need_h else 1)
+            st = trial[1] if trial is not None and not need_h else eq.evaluate(u, lam, 2 if need_h else 1)
+            trial = None
             if not np.isfinite(st.energy) or not np.all(np.isfinite(st.gradient)):
                 if back is None:
                     raise _Failed(f"non-finite energy or forces at load factor {lam:.6g}")
@@ -776,14 +785,17 @@ class PathSolver:
                 # meaningless (it would cut steps at random), and near the solution the Newton
                 # step is accepted as it is
                 if slope < 0 and -slope > 1e-10 * abs(st.energy):
-                    e_new = eq.energy(u + du, lam)
+                    # each trial's energy comes from a gradient evaluation: the state of the step
+                    # taken is the next iterate's (on the 10k ball's pinch one evaluation fewer per
+                    # Newton step; tests/solve/test_path_reuse.py)
+                    e_new = trial_at(1.0)
                     if not (need_h or fresh) and not (np.isfinite(e_new) and e_new <= st.energy + 1e-4 * slope):
                         if stepped_local:
                             # a local correction's step that overshoots (the dimple's stiffness
                             # changes fast): back-tracked first
                             for _ in range(LOCAL_BACKTRACKS):
                                 alpha *= 0.5
-                                e_new = eq.energy(u + alpha * du, lam)
+                                e_new = trial_at(alpha)
                                 if np.isfinite(e_new) and e_new <= st.energy + 1e-4 * alpha * slope:
                                     break
                             else:
@@ -793,15 +805,17 @@ class PathSolver:
                             # tangent (by GMRES if it can, else factorised here)
                             st, du, need_h = refresh(u, st, cres, keep_near=True)
                             slope = float(st.gradient @ du)
-                            e_new = eq.energy(u + du, lam)
+                            e_new = trial_at(1.0)
                     for _ in range(8):
                         if np.isfinite(e_new) and e_new <= st.energy + 1e-4 * alpha * slope:
                             break
                         alpha *= 0.5
-                        e_new = eq.energy(u + alpha * du, lam)
+                        e_new = trial_at(alpha)
                     else:
                         alpha = 1.0                      # no decrease found: plain Newton step
                 step = alpha * du
+                if trial is not None and trial[0] != alpha:
+                    trial = None
             if feasible and opt.reuse_factorisation and not inexact and not stepped_local:
                 # (a local correction's step is not mixed: on the 10k ball's pinch, mixed, the path's
                 # longest step stalled and took 4 factorisations instead of 1)
@@ -1007,6 +1021,7 @@ class PathSolver:
             except SolverError:
                 u0, factored = u.copy(), False
             snapped = None
+            made = self.eq.n_factorisations                   # (a failed attempt that makes none keeps it)
             try:
                 # bracketing a limit point that a step jumped over, or an attempt beyond its
                 # estimated load: an attempt beyond it has no equilibrium to converge to, and one
@@ -1032,7 +1047,12 @@ class PathSolver:
                                   f"its ends by {ratio:.3g} of itself (jump_ratio {opt.jump_ratio:g}): a limit point "
                                   "or another branch crossed")
             except (_Failed, SolverError) as exc:
-                factored, plain, t_new = False, False, None
+                # an attempt that made no factorisation (its predicted state was not finite, or it
+                # failed on the reused tangent) leaves the current point's, and its tangent du/dlam,
+                # as they were: the next attempt reuses both (on the 10k ball's pinch one
+                # factorisation fewer, 11 -> 10)
+                kept = factored and t_cur is not None and self.eq.n_factorisations == made
+                factored, plain, t_new = kept, False, t_cur if kept else None
                 limit = softening or jumped is not None       # a limit point ahead: bracket it to ``near``
                 if abs(step) / 2 >= (max(dmin, near) if limit else dmin):
                     log.info("step to %.6g failed (%s); halving", lam_new, exc)
