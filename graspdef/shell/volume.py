@@ -46,6 +46,9 @@ def _volume_terms(x, stencils, N, dN, w, nstride, order, index, base, bstride, g
             p = np.empty((nq, 3))
             a1 = np.empty((nq, 3))
             a2 = np.empty((nq, 3))
+            P = np.empty((nq, S, 3))
+            Q = np.empty((nq, S, 3))
+            R = np.empty((nq, S, 3))
             Vb = 0.0
             for k in range(bstart[blk], bstart[blk + 1]):
                 f = forder[k]
@@ -83,21 +86,26 @@ def _volume_terms(x, stencils, N, dN, w, nstride, order, index, base, bstride, g
                             grad[r, 2] += Ns * m2 + d1 * b2 + d2 * c2
                 if order < 2:
                     continue
+                # v_st = sum_q [dN1_s P_t + N_s Q_t + dN2_s R_t] with P_t = w (N_t a2 - dN2_t x),
+                # Q_t = w (dN2_t a1 - dN1_t a2), R_t = w (dN1_t x - N_t a1) (the docstring's sum,
+                # grouped by the s factors)
+                for q in range(nq):
+                    for t in range(S):
+                        Nt, d1t, d2t = w[q] * N[fb, q, t], w[q] * dN[fb, q, t, 0], w[q] * dN[fb, q, t, 1]
+                        for d in range(3):
+                            P[q, t, d] = Nt * a2[q, d] - d2t * p[q, d]
+                            Q[q, t, d] = d2t * a1[q, d] - d1t * a2[q, d]
+                            R[q, t, d] = d1t * p[q, d] - Nt * a1[q, d]
                 for s in range(S):
                     for t in range(s + 1, S):
                         v0 = 0.0
                         v1 = 0.0
                         v2 = 0.0
                         for q in range(nq):
-                            Ns, Nt = N[fb, q, s], N[fb, q, t]
-                            d1s, d1t = dN[fb, q, s, 0], dN[fb, q, t, 0]
-                            d2s, d2t = dN[fb, q, s, 1], dN[fb, q, t, 1]
-                            ca2 = w[q] * (d1s * Nt - Ns * d1t)
-                            ca1 = w[q] * (Ns * d2t - d2s * Nt)
-                            cp = w[q] * (d2s * d1t - d1s * d2t)
-                            v0 += ca2 * a2[q, 0] + ca1 * a1[q, 0] + cp * p[q, 0]
-                            v1 += ca2 * a2[q, 1] + ca1 * a1[q, 1] + cp * p[q, 1]
-                            v2 += ca2 * a2[q, 2] + ca1 * a1[q, 2] + cp * p[q, 2]
+                            Ns, d1s, d2s = N[fb, q, s], dN[fb, q, s, 0], dN[fb, q, s, 1]
+                            v0 += d1s * P[q, t, 0] + Ns * Q[q, t, 0] + d2s * R[q, t, 0]
+                            v1 += d1s * P[q, t, 1] + Ns * Q[q, t, 1] + d2s * R[q, t, 1]
+                            v2 += d1s * P[q, t, 2] + Ns * Q[q, t, 2] + d2s * R[q, t, 2]
                         # block (s, t) = [v]_x, block (t, s) = its transpose
                         kk = index[(f * S + s) * S + t]
                         o, st_ = base[kk], bstride[kk]
