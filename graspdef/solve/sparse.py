@@ -523,7 +523,9 @@ class KKTSystem:
             if B is None:
                 y = y - self._back(self._apply(y))
             else:
-                Z = self._back(np.column_stack([self._apply(y), self._apply(X) - B]))
+                AY = self._apply(np.column_stack([y, X]))      # one pass over K for the block
+                AY[:, 1:] -= B
+                Z = self._back(AY)
                 y, X = y - Z[:, 0], X - Z[:, 1:]
             new = float(np.linalg.norm(y))
             if not np.isfinite(new) or not new <= 0.5 * size:
