@@ -109,6 +109,7 @@ class EnclosedGas(TermBase):
                                f"p0={self.p0!r}, p_atm={self.p_atm!r}")
         _require_closed(shell, "an enclosed gas")
         self._vol = EnclosedVolume(shell)
+        self._last = None                               # (x, V, dV/dx) of the last evaluation (hessian_rows)
         self.V0 = self._vol.value(shell.rest_positions)
         if self.V0 <= 0:
             raise ProblemError(f"enclosed gas: the surface encloses a non-positive volume ({self.V0:.3g} m^3); "
@@ -132,8 +133,10 @@ class EnclosedGas(TermBase):
             return PotentialTerms(self._value(self._vol.value(x)), None, None)
         if order < 2:
             V, g = self._vol.gradient(x)
+            self._last = (x.copy(), V, g)
             return PotentialTerms(self._value(V), -self.gauge_pressure(V) * g, None)
         V, g, H = self._vol.hessian(x)
+        self._last = (x.copy(), V, g)
         pg = self.gauge_pressure(V)
         H.data *= -pg
         return PotentialTerms(self._value(V), -pg * g, H, [(self._stiffness(V), g)])
@@ -143,7 +146,10 @@ class EnclosedGas(TermBase):
         return (self.p_atm + self.p0) * self.V0 / V ** 2
 
     def hessian_rows(self, x: np.ndarray, lam: float, region) -> tuple:
-        V, g = self._vol.gradient(x)                    # the pressure and the rank-one part are the whole volume's
+        # the pressure and the rank-one part are the whole volume's: those of the last evaluation
+        # when it was at this x (a local correction's rows follow its iterate's gradient), else computed
+        last = self._last
+        V, g = last[1:] if last is not None and np.array_equal(last[0], x) else self._vol.gradient(x)
         H = region.volume.hessian(x, scale=-self.gauge_pressure(V))[2]
         return H, [(self._stiffness(V), g)]
 

@@ -83,3 +83,25 @@ def test_no_state_is_evaluated_twice(monkeypatch, sub):
     sol = solve_nonlinear(_ball(sub, 20.0), PathOptions(steps=10))
     assert sol.completed and len(seen) > 20 and (sol.n_local > 0) == (sub == 4)
     assert repeats == []
+
+
+def test_the_gas_rows_follow_their_own_state():
+    """The enclosed gas's Hessian rows take the volume and its gradient from the term's last
+    evaluation only when that was at the same positions: after an evaluation elsewhere its rows
+    at x are still those of a fresh term at x (bit for bit), and after one at x as well."""
+    from graspdef.shell.region import Region, vertex_rings
+
+    pr = _ball(3, 20.0)
+    eq = Equilibrium(pr)
+    try:
+        gas = next(t for t in eq.terms if type(t).__name__ == "EnclosedGas")
+        fresh = next(t for t in Equilibrium(pr).terms if type(t).__name__ == "EnclosedGas")
+        reg = Region(pr.shell, vertex_rings(pr.shell, [int(np.argmax(eq.X[:, 2]))], 2))
+        x = eq.X * np.array([1.05, 1.05, 0.9])
+        want_M, ((want_c, want_g),) = fresh.hessian_rows(x, 0.5, reg)
+        for at in (eq.X * 1.02, x):                 # the last evaluation elsewhere, then at x
+            gas.evaluate(at, 0.5, 1)
+            M, ((c, g),) = gas.hessian_rows(x, 0.5, reg)
+            assert np.array_equal(M.data, want_M.data) and c == want_c and np.array_equal(g, want_g)
+    finally:
+        eq.close()
