@@ -488,15 +488,19 @@ class KKTSystem:
         G would have a real eigenvalue mu = 1/t >= 1.  The certificate is the homogeneous
         iteration y <- G y = y - M^-1 (A y) (A in double, M^-1 a single back-substitution) from a
         fixed pseudo-random y_0 ~ N(0, I): with u a unit left eigenvector of such an eigenvalue,
-        u.y_k = mu^k u.y_0, so |y_k| >= |u.y_0|, and |y_k| can fall to
-        :data:`CERTIFICATE_REDUCTION` |y_0| only if |u.y_0| (a standard normal) is below
-        CERTIFICATE_REDUCTION sqrt(N): probability < 1e-7 up to a million unknowns.  The iteration is
+        u.y_k = mu^k u.y_0, so |y_k| >= |u.y_0|: |y_k| can fall to c = :data:`CERTIFICATE_MISS`
+        sqrt(pi / 2) only if |u.y_0|, a standard normal, is below c, which has the probability
+        erf(c / sqrt(2)) < c sqrt(2 / pi) = CERTIFICATE_MISS (1e-7) for any number of unknowns N
+        (|y_0| ~ sqrt(N): a reduction of |y| by ~1.25e-7 / sqrt(N); until 2026-12-07 by 1e-10 at every N,
+        the bound at a million unknowns, which on the 10k ball, 30,732 unknowns, asked 7 of its 9
+        certificates for a third step).  The iteration is
         required to reach that within :data:`MIXED_REFINEMENTS` steps, each at least halving |y|.
         It watches the error, not the residual: near a critical point the matrix has an eigenvalue
         far below single precision's rounding of it, where a residual shows nothing (one of 1e-12
         of the largest: the residual test passed on a factor whose inertia was a coin toss) but
         G's eigenvalue is ~1 and |y| stalls; that factor is then replaced by a double one.
-        Costs 2-3 back-substitutions and products on the 10k ball's tangents (|y| shrinks by ~1e-6 per step).
+        Costs 2 back-substitutions and products on the 10k ball's tangents (|y| shrinks by ~1e-5 per
+        step, to 0.8-3.0e-10 |y_0| after two, against 7.2e-10 asked).
 
         ``along`` (n,) or (n, k), ``g`` (m,) or (m, k) (zero if None): right-hand sides [f; g] of the
         KKT system whose plain refinement steps x <- x - M^-1 (A x - [f; g]) from x = 0 ride in the
@@ -531,7 +535,7 @@ class KKTSystem:
             if not np.isfinite(new) or not new <= 0.5 * size:
                 break
             size = new
-            if size <= CERTIFICATE_REDUCTION * size0:
+            if size <= CERTIFICATE_MISS * math.sqrt(math.pi / 2):
                 ok = True
                 break
         self.certificates += 1
@@ -795,8 +799,10 @@ MIXED_REFINEMENTS = 12
 #: the same decisions in every run)
 CERTIFICATE_SEED = 20261127
 
-#: The factor by which :meth:`KKTSystem.certify_inertia`'s iteration must shrink its start vector
-CERTIFICATE_REDUCTION = 1e-10
+#: The largest probability that :meth:`KKTSystem.certify_inertia` passes a single factor whose
+#: inertia differs from the matrix's: its iteration must bring |y| (from y_0 ~ N(0, I)) below
+#: CERTIFICATE_MISS sqrt(pi / 2), whatever the number of unknowns
+CERTIFICATE_MISS = 1e-7
 
 #: Most GMRES iterations of a mixed-precision solve's correction (:meth:`KKTSystem._gmres_refine`):
 #: each costs a single-precision back-substitution, below a double factorisation's cost by ~50x at
