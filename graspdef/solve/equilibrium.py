@@ -213,9 +213,6 @@ class Equilibrium:
         self.n_hessians += order == 2
         return State(float(E), grad, H, rank_one, q, internal, floor, rows=rows, terms=parts)
 
-    def energy(self, u: np.ndarray, lam: float) -> float:
-        return self.evaluate(u, lam, order=0).energy
-
     def commit(self, u: np.ndarray) -> None:
         """Tell the state-tracking terms (edge rotations) that ``u`` is converged."""
         x = self.X + u.reshape(-1, 3)
