@@ -96,6 +96,10 @@ KRYLOV_ETA_MAX = 0.1
 #: tennis ball's pads at 21.48 N 45 -> 38, at 10 N 37 -> 32, at 30 N 63 -> 43, with 8 and 16 initial
 #: steps 52 -> 46 and 49 -> 47; its pins 23 -> 19; the duck at 0.5 N 90 -> 71; the soda can 11 -> 11.
 #: An exact line search (bounded Brent to 1e-3) gives 39 on the pads: one trial takes most of it.
+#: Not better everywhere: a 162-vertex linear-elastic sphere crushed between pads at 2 N (a snap)
+#: 102 -> 145.  Not in the patient descent past a limit point (``newton(patient=True)``), which
+#: back-tracks by halving alone: with the parabola there the paper duck at 0.5 N (point loads) lost
+#: its jump past the limit point at load factor 0.712 and stopped there instead of at 0.846.
 PARABOLA_MIN_MOVE = 0.1
 
 
@@ -844,10 +848,11 @@ class PathSolver:
                         e_new = trial_at(alpha)
                     else:
                         alpha = 1.0                      # no decrease found: plain Newton step
-                    if alpha < 1 and (need_h or fresh):
+                    if alpha < 1 and (need_h or fresh) and not patient:
                         # a damped step on this iterate's own tangent (contact paths: samples that enter
                         # the barrier during the step are not in its linearisation): one more trial, at
-                        # the parabola's minimum, taken if its energy is lower still (PARABOLA_MIN_MOVE)
+                        # the parabola's minimum, taken if its energy is lower still; not in the patient
+                        # descent past a limit point (PARABOLA_MIN_MOVE)
                         aq = parabola_step(st.energy, slope, alpha, e_new, e_twice)
                         if aq is not None:
                             kept = trial
