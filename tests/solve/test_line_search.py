@@ -71,7 +71,7 @@ def _pads(F):
 
 
 def test_the_patient_descent_past_a_limit_point_back_tracks_by_halving_alone():
-    """Newton from rest straight to the whole force of the pads' squeeze below (1 N each), the
+    """Newton from rest straight to the whole force of the pads' squeeze (``_pads``, 1 N each), the
     damped steps on fresh tangents of a descent: as an ordinary attempt it takes a trial at a
     parabola's minimum, as the patient descent past a limit point none; both reach the same
     equilibrium (to 1e-6 of the largest displacement: the Newton tolerance)."""
