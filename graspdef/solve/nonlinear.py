@@ -194,7 +194,9 @@ class PathOptions:
     max_step : largest load-factor increment of a load-controlled step (None: no cap; the step
         grows after easy steps).  A path compared as a curve by interpolation between its points
         (graspdef.bench, ``compare = "curve"``) is capped at max_load / steps
-    line_search : energy back-tracking in load control
+    line_search : energy back-tracking in load control (halving; a step back-tracked on its own
+        tangent then takes one trial at the minimum of the parabola through its trials,
+        :func:`parabola_step` -- not in the patient descent past a limit point)
     max_probe_displacement : [m] the path also ends (completed) once a probe has moved this far
         (for paths whose load never reaches ``max_load``, e.g. past a pressure maximum)
     reuse_factorisation, reuse_ratio : in load control, reuse a factorised tangent (the previous
