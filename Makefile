@@ -1,12 +1,12 @@
 # graspdef: two commands on a fresh Debian/Ubuntu machine.
 #   make demo   set up (.venv, package, dependencies) and run the main job
-#   make test   set up, then run the test suite (tests marked `slow` or `ooc_cli` are excluded), one worker per core
+#   make test   set up, then run the test suite (tests marked `slow` are excluded), one worker per core
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: setup demo test test-slow test-ooc clean system-packages
+.PHONY: setup demo test test-slow clean system-packages
 
 # Debian packages the Python dependencies need at run time (installed when run as root):
 # gcc and python3-dev (numba's pycc compiles and links the ahead-of-time kernels), libgomp1 (numba's OpenMP), libusb-1.0-0 (open3d), chromium + driver (browser tests), and
@@ -59,15 +59,10 @@ demo: setup
 XDIST  := -n auto --maxprocesses 4 --dist loadfile
 
 test: setup
-	$(PY) -m pytest -q -m "not slow and not ooc_cli" $(XDIST)
+	$(PY) -m pytest -q -m "not slow" $(XDIST)
 
 test-slow: setup
 	$(PY) -m pytest -q -m slow $(XDIST)
-
-# graspdef solve out of core end to end: MKL 2026.2's out-of-core mode fails about once in 120
-# runs of these on a busy machine (docs/speed.md, "Out of core", cause open), so `make test` leaves them out
-test-ooc: setup
-	$(PY) -m pytest -q -m ooc_cli tests/solve/test_kkt_out_of_core.py
 
 clean:
 	rm -rf $(VENV) out .pytest_cache

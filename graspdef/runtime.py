@@ -54,7 +54,6 @@ All only fill in environment variables the user has not set.
 """
 from __future__ import annotations
 
-import contextlib
 import glob
 import os
 import sys
@@ -83,32 +82,9 @@ def configure() -> dict:
             "MUJOCO_GL": os.environ["MUJOCO_GL"], "PYPARDISO_MKL_RT": locate_mkl_rt()}
 
 
-@contextlib.contextmanager
-def environment(values: dict[str, str]):
-    """Set environment variables for a block and restore them after: for libraries that read
-    their settings from the environment at call time (MKL PARDISO's out-of-core folder and memory,
-    graspdef.solve.sparse).  An empty ``values`` changes nothing."""
-    saved = {k: os.environ.get(k) for k in values}
-    try:
-        os.environ.update(values)
-        yield
-    finally:
-        for k, v in saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-
-
-def end_process(status: int) -> None:
-    """End the process now with ``status``: flush stdout, stderr and the logging handlers, then
-    ``os._exit`` -- without Python's and the C/C++ runtime's teardown (atexit handlers, module
-    clean-up, static destructors).  For the console script after MKL PARDISO's out-of-core mode,
-    which has been seen to crash a process at exit (graspdef.cli.console); everything the run
-    writes must be closed before."""
-    import logging
-
-    sys.stdout.flush()
-    sys.stderr.flush()
-    logging.shutdown()
-    os._exit(status)
+def set_environment(values: dict[str, str]) -> None:
+    """Set environment variables for the rest of the process: for a process of one library's own
+    whose settings that library reads from the environment at call time -- the out-of-core PARDISO
+    worker, where MKL reads its factor files' folder and memory at every call
+    (graspdef.solve.pardiso_ooc)."""
+    os.environ.update(values)

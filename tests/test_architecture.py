@@ -82,12 +82,13 @@ def test_siblings_do_not_import_each_other(path):
 
 #: private members of *third-party* objects a module needs (not graspdef's rooms): pypardiso has no
 #: public API for PARDISO's phases (analysis once, factorisation per step; ../shared/MEASURED.md),
-#: nor for a call on zero-based 32-bit indices or single-precision values (KKTSystem._call uses its
+#: nor for a call on zero-based 32-bit indices or single-precision values (graspdef.solve.pardiso.call uses its
 #: loaded MKL function and handle type),
 #: nor for the MKL library it loaded (the sweep records which one its workers use); ``os._exit`` is
-#: Python's documented way to end a process without its teardown (runtime.end_process)
-THIRD_PARTY_PRIVATE = {"solve/sparse.py": {"_mkl_pardiso", "_pt_type"}, "sweep/run.py": {"_name"},
-                       "runtime.py": {"_exit"}}
+#: Python's documented way to end a process without its teardown (the out-of-core worker, which ran
+#: MKL's out-of-core mode: graspdef.solve.pardiso_ooc)
+THIRD_PARTY_PRIVATE = {"solve/pardiso.py": {"_mkl_pardiso", "_pt_type"}, "sweep/run.py": {"_name"},
+                       "solve/pardiso_ooc.py": {"_exit"}}
 
 
 def _defined_private_names(tree) -> set:

@@ -142,24 +142,9 @@ def _main(argv: list[str] | None) -> tuple[int, argparse.Namespace | None]:
 
 def console() -> None:
     """The ``graspdef`` console script: :func:`main`, then the process ends with its status.
-
-    A subcommand that used PARDISO's out-of-core mode (``graspdef solve --backend pardiso-ooc``)
-    sets ``args.end_process``; the process then ends by :func:`graspdef.runtime.end_process` once its
-    output is flushed, without Python's and the C++ runtime's teardown: MKL 2026.2's out-of-core mode has been seen to
-    crash a process *at exit*, after every result was written and correct (an LLVM assertion in
-    numba's llvmlite, or a segfault; measured: 1 of 60 processes with two out-of-core solvers,
-    1 of 30 ``graspdef solve`` runs in the test suite, docs/speed.md, "Out of core"), which turned a
-    finished run's status 0 into -6.  Everything the run writes is closed before (its files, the
-    solver's temporary folder).  Those crashes were measured before 2026-11-27, when three causes of
-    memory corruption were found and avoided (a one-byte heap overflow in MKL for a folder given
-    with a trailing separator, graspdef.solve.sparse.ooc_path; a second out-of-core handle in a
-    process, require_one_ooc_handle; MKL's threads, require_sequential_mkl: README "Out of
-    core"); the guard stays, as it costs nothing."""
-    rc, args = _main(None)
-    if getattr(args, "end_process", False):
-        from ..runtime import end_process
-
-        end_process(rc)
+    (MKL's out-of-core mode, which crashed processes at exit, runs in a worker process of its own:
+    graspdef.solve.pardiso_ooc.)"""
+    rc, _ = _main(None)
     sys.exit(rc)
 
 

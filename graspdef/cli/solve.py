@@ -39,7 +39,6 @@ def run(args: argparse.Namespace) -> int:
     progress(args, f"shell: {shell.mesh.n_real} control vertices (+{shell.n_control - shell.mesh.n_real} ghosts), "
                    f"{shell.mesh.n_real_faces} faces; set-up {time.perf_counter() - t0:.2f} s")
     backend = args.backend or spec.backend
-    args.end_process = backend == "pardiso-ooc"       # graspdef.cli.console: no teardown after MKL's out-of-core mode
     unit = spec.length_unit
     stopped = None
     if spec.solver.get("type", "linear") == "nonlinear":

@@ -57,8 +57,8 @@ def _add(A: sp.spmatrix, B: sp.spmatrix) -> sp.csr_matrix:
     structure as it is (scipy's sum would drop its explicit zeros).  Two different structures are
     summed on their union with explicit zeros kept as well: a flat shell's Hessian at rest has exact
     zeros where a bent one has none (the cantilever: 31,203 against 55,359 non-zeros), and dropping
-    them changed the tangent's pattern after the first step -- a second PARDISO analysis (in core),
-    a refused solve (out of core, graspdef.solve.sparse.require_one_ooc_handle)."""
+    them changed the tangent's pattern after the first step -- a second PARDISO analysis (in core,
+    and out of core a fresh worker process: graspdef.solve.pardiso_ooc)."""
     if B.nnz == 0 or A.nnz == 0:
         C = (A if B.nnz == 0 else B).tocsr()
         return sp.csr_matrix((C.data.copy(), C.indices, C.indptr), shape=C.shape)

@@ -19,7 +19,6 @@ the factorisation, but the solution is then refined iteratively and its residual
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import logging
 import math
 import os
@@ -34,7 +33,10 @@ import scipy.sparse.linalg as spla
 
 from ..errors import SolverError, SupportError
 from ..problem.problem import BACKENDS, PRECISIONS
-from ..runtime import environment, locate_mkl_rt
+from ..runtime import locate_mkl_rt
+from . import pardiso
+from .pardiso import new_solver as _new_pardiso
+from .pardiso_ooc import OOCPardiso
 
 log = logging.getLogger(__name__)
 
@@ -68,20 +70,6 @@ def pardiso_available() -> bool:
     except Exception:       # ImportError, or mkl_rt missing
         return False
     return True
-
-
-def _new_pardiso(mtype: int):
-    """A PyPardisoSolver.  pypardiso looks for MKL's runtime library on every solver it creates
-    (a recursive search of sys.prefix, ~1 s, and 2-4 s on a loaded machine) unless the environment
-    variable PYPARDISO_MKL_RT names it.  :func:`graspdef.runtime.locate_mkl_rt` names it (once,
-    only if unset and only where pip's mkl wheel puts it), here as well as in
-    :func:`graspdef.runtime.configure`, so that a library user who never calls ``configure``
-    does not pay the search per solver (measured on a loaded machine: the import 3.1 -> 1.1 s,
-    each further solver 1.7 s -> 0)."""
-    locate_mkl_rt()
-    import pypardiso
-
-    return pypardiso.PyPardisoSolver(mtype=mtype)
 
 
 def _cnr_threads(solver) -> int:
@@ -307,35 +295,27 @@ class KKTSystem:
 
     def close(self) -> None:
         if self._solver is not None:
-            with self._ooc_environment():
-                self._solver.free_memory(everything=True)
+            self._solver.free_memory(everything=True)     # out of core: its worker process ends
             self._solver = None
             self._map = None                                # a new solver needs a new analysis
         if self._ooc_dir is not None:
             shutil.rmtree(self._ooc_dir, ignore_errors=True)
             self._ooc_dir = None
 
-    @contextlib.contextmanager
-    def _ooc_environment(self):
-        """For pardiso-ooc, around every PARDISO call (nothing for the in-core backends): MKL reads
-        where to put its factor files and how much of the factor to keep in memory from the
-        environment (set here and restored after: no lasting change to the process).
+    def _ooc_env(self) -> dict[str, str]:
+        """pardiso-ooc: MKL's out-of-core settings, which it reads from the environment of the worker
+        process (graspdef.solve.pardiso_ooc) at every call: the factor files' folder, the factor's
+        part held in memory [MB], and no files kept.
 
         The folder is given **without a trailing separator**: MKL 2026.2 appends "/mkl_pardiso" to
         the path itself, and for a path that ends in "/" its configuration reader
         (``mkl_pds_lp64_pardiso_ooc_read_cfg_file``, in ``mkl_serv_sprintf_s``) writes one byte past
         a heap buffer -- found with valgrind's memcheck (an "Invalid write of size 1", 7 bytes after
-        a 56-byte Python object) on a 900-unknown system; with the path "/tmp/x/" the same, with
-        "/tmp/x" or any path without the final "/" none.  The overwritten byte lands wherever the
-        heap puts the buffer's neighbour.  MKL runs on its sequential layer for out-of-core solves
-        (:func:`require_sequential_mkl`) with one handle per process (:func:`require_one_ooc_handle`)."""
-        if self._ooc_dir is None:
-            yield
-            return
-        with environment({"MKL_PARDISO_OOC_PATH": ooc_path(self._ooc_dir),
-                          "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(self.ooc_core_mb),
-                          "MKL_PARDISO_OOC_KEEP_FILE": "0"}):
-            yield
+        a 56-byte block) on a 900-unknown system; with the path "/tmp/x/" the same, with
+        "/tmp/x" or any path without the final "/" none."""
+        return {"MKL_PARDISO_OOC_PATH": ooc_path(self._ooc_dir),
+                "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(self.ooc_core_mb),
+                "MKL_PARDISO_OOC_KEEP_FILE": "0"}
 
     def factor(self, K: sp.spmatrix, analyse: bool = False, rows: RowSummary | None = None) -> None:
         """Factor the KKT matrix of ``K``; ``analyse`` forces a fresh ordering/matching; ``rows``:
@@ -372,42 +352,41 @@ class KKTSystem:
         dtype = np.float32 if self.single else np.float64
         U = upper_map.upper(K, self.scale, dtype)
         if self.backend == "pardiso-ooc" and self._solver is not None and new_pattern:
-            # out of core, one PARDISO handle and one analysis per process (require_one_ooc_handle):
-            # a pattern inside the analysed one is factorised on it (its missing entries zero),
-            # any other is refused
-            K, upper_map = self._on_analysed_pattern(K), self._map
-            new_pattern = False
-            U = upper_map.upper(K, self.scale, dtype)
+            # out of core a second analysis is a fresh worker's (graspdef.solve.pardiso_ooc; a second
+            # analysis on one handle crashed the process): a pattern inside the analysed one -- a
+            # Newton tangent with an exact zero more -- is factorised on it (its missing entries zero)
+            inside = self._on_analysed_pattern(K)
+            if inside is not None:
+                K, upper_map, new_pattern = inside, self._map, False
+                U = upper_map.upper(K, self.scale, dtype)
+            else:
+                self._solver.free_memory(everything=True)
+                self._solver = None
         if self._solver is None:
-            solver = _new_pardiso(-2)
-            if self.backend == "pardiso-ooc":
-                require_sequential_mkl(solver.libmkl)
-                require_one_ooc_handle()
-            self._solver = solver
-            ooc = {60: 2} if self.backend == "pardiso-ooc" else {}
+            ooc = self.backend == "pardiso-ooc"
             if ooc and self._ooc_dir is None:
                 self._ooc_dir = ooc_folder()
-            for k, v in {**_PARDISO_IPARM, **self._variant_iparm(), **ooc, 28: int(self.single),
-                         34: _cnr_threads(solver)}.items():
+            # out of core: a worker process on MKL's sequential layer (one thread)
+            solver = OOCPardiso(-2) if ooc else _new_pardiso(-2)
+            self._solver = solver
+            for k, v in {**_PARDISO_IPARM, **self._variant_iparm(), **({60: 2} if ooc else {}), 28: int(self.single),
+                         34: 1 if ooc else _cnr_threads(solver)}.items():
                 self._solver.set_iparm(k, v)
         s = self._solver
         self._U = U
         z = np.zeros((U.shape[0], 1), dtype)
         try:
             if analyse or new_pattern:
-                with self._ooc_environment():
-                    self._call(11, z)                   # analysis (matching, ordering)
+                self._call(11, z)                       # analysis (matching, ordering)
                 self._map = upper_map                   # kept once PARDISO has analysed it
                 if self._ooc_dir is not None:
                     self._fit_ooc_core(int(s.get_iparm(61)))
-            with self._ooc_environment():
-                self._call(22, z)                       # numerical factorisation
+            self._call(22, z)                           # numerical factorisation
         except Exception as exc:
             if self._ooc_dir is None or getattr(exc, "value", None) != -9:
                 raise
             # -9: the in-memory part allowed is below what PARDISO's out-of-core mode needs for this
-            # matrix although its analysis said otherwise (_fit_ooc_core; not seen since 2026-11-27).
-            # A second handle with more memory is what corrupted memory (require_one_ooc_handle)
+            # matrix although its analysis said otherwise (_fit_ooc_core; not seen since 2026-11-27)
             raise SolverError(f"PARDISO out of core: {self.ooc_core_mb} MB in memory were too few for this "
                               "matrix's factorisation (error -9) although its analysis asked for no more; "
                               "raise graspdef.solve.sparse.OOC_CORE_MB and run again") from None
@@ -416,18 +395,16 @@ class KKTSystem:
         self.perturbed = int(s.get_iparm(14))
         self.n_negative = int(s.get_iparm(23))
 
-    def _on_analysed_pattern(self, K: sp.csr_matrix) -> sp.csr_matrix:
+    def _on_analysed_pattern(self, K: sp.csr_matrix) -> sp.csr_matrix | None:
         """pardiso-ooc: ``K`` on the analysed pattern (its entries there, explicit zeros elsewhere),
-        or SolverError if K has an entry outside it."""
+        or None if K has an entry outside it."""
         a = self._map
         ref = sp.csr_matrix((np.zeros(a.indices.size), a.indices, a.indptr), shape=K.shape)
         union = union_sum(K, ref)
         if not a.matches(union):
-            raise SolverError(
-                f"PARDISO out of core: the matrix's sparsity pattern changed ({a.indices.size:,} analysed non-zeros, "
-                f"{union.nnz:,} now), which needs a second analysis, and out of core that needs a second "
-                "PARDISO handle in the process (refused: docs/speed.md, 'Out of core'); solve this problem in core "
-                "(backend 'pardiso') or with a fixed pattern")
+            log.info("PARDISO out of core: the pattern changed (%d analysed non-zeros, %d now): a fresh worker "
+                     "analyses it", a.indices.size, union.nnz)
+            return None
         return union
 
     def _fit_ooc_core(self, need_kb: int) -> None:
@@ -574,11 +551,6 @@ class KKTSystem:
             self._factor_pardiso(True)
             self.seconds_factor += time.perf_counter() - t0
             return True
-        if self.backend == "pardiso-ooc":
-            # another variant needs a fresh handle, which out of core is not allowed
-            # (require_one_ooc_handle): the check's failure stands
-            log.info("KKT: no refactorisation with other settings out of core (one PARDISO handle per process)")
-            return False
         n_var = 1 + len(_PARDISO_FALLBACKS)
         nxt = next(((self.variant + k) % n_var for k in range(1, n_var) if (self.variant + k) % n_var not in self._tried), None)
         if nxt is None:
@@ -587,8 +559,7 @@ class KKTSystem:
         log.info("KKT: refactoring with PARDISO settings %s after a failed check", _PARDISO_FALLBACKS[nxt - 1] if nxt else "(defaults)")
         self._tried.add(nxt)
         self.variant = nxt
-        with self._ooc_environment():
-            self._solver.free_memory(everything=True)      # a fresh solver: every iparm from the variant
+        self._solver.free_memory(everything=True)          # a fresh solver: every iparm from the variant
         self._solver = None
         self._factor_pardiso(True)
         self.seconds_factor += time.perf_counter() - t0
@@ -613,11 +584,9 @@ class KKTSystem:
                 b2 = b.reshape(b.shape[0], -1)
                 beta = np.abs(b2).max(axis=0)
                 beta[~(beta > 0) | ~np.isfinite(beta)] = 1.0
-                with self._ooc_environment():
-                    x = self._call(33, np.asfortranarray(b2 / beta, np.float32))
+                x = self._call(33, np.asfortranarray(b2 / beta, np.float32))
                 return (np.asarray(x, float) * beta).reshape(b.shape)
-            with self._ooc_environment():
-                x = self._call(33, np.asfortranarray(b, self._U.dtype))
+            x = self._call(33, np.asfortranarray(b, self._U.dtype))
             return np.ascontiguousarray(x, float).reshape(b.shape)
         return self._lu.solve(b)
 
@@ -658,29 +627,13 @@ class KKTSystem:
         return X, R, eta
 
     def _call(self, phase: int, b: np.ndarray) -> np.ndarray:
-        """One call of MKL's ``pardiso`` on the last KKT upper triangle (``self._U``: zero-based
-        32-bit indices, iparm 35 = 1; float32 values when iparm 28 = 1) with right-hand sides ``b``
-        (Fortran order, U's dtype); returns x.  pypardiso's own call copies the index arrays to
-        one-based ones at every call (at 100k: 2 x 68 MB) and accepts float64 only; this one passes
-        them as they are.  Raises pypardiso's
-        PyPardisoError (``value``: PARDISO's error code)."""
-        from pypardiso.pardiso_wrapper import PyPardisoError
-
-        s, U = self._solver, self._U
-        x = np.zeros_like(b)
-        err = ctypes.c_int32(0)
-        i32p, f64p = ctypes.POINTER(ctypes.c_int32), ctypes.POINTER(ctypes.c_double)
-        s._mkl_pardiso(s.pt.ctypes.data_as(ctypes.POINTER(s._pt_type[0])),
-                       ctypes.byref(ctypes.c_int32(1)), ctypes.byref(ctypes.c_int32(1)),      # maxfct, mnum
-                       ctypes.byref(ctypes.c_int32(s.mtype)), ctypes.byref(ctypes.c_int32(phase)),
-                       ctypes.byref(ctypes.c_int32(U.shape[0])),
-                       U.data.ctypes.data_as(f64p), U.indptr.ctypes.data_as(i32p), U.indices.ctypes.data_as(i32p),
-                       s.perm.ctypes.data_as(i32p), ctypes.byref(ctypes.c_int32(1 if b.ndim == 1 else b.shape[1])),
-                       s.iparm.ctypes.data_as(i32p), ctypes.byref(ctypes.c_int32(int(s.msglvl))),
-                       b.ctypes.data_as(f64p), x.ctypes.data_as(f64p), ctypes.byref(err))
-        if err.value != 0:
-            raise PyPardisoError(err.value)
-        return x
+        """One PARDISO phase on the last KKT upper triangle (``self._U``) with right-hand sides ``b``
+        (Fortran order, U's dtype): :func:`graspdef.solve.pardiso.call` in this process, or out of
+        core in the system's worker process (:class:`graspdef.solve.pardiso_ooc.OOCPardiso`)."""
+        U = self._U
+        if self.backend == "pardiso-ooc":
+            return self._solver.call(phase, U, b, self._ooc_env())
+        return pardiso.call(self._solver, phase, U.data, U.indptr, U.indices, b)
 
     def solve(self, f: np.ndarray, g: np.ndarray | None = None, rtol: float = 1e-8,
               refinements: int = 3, exact: bool = True,
@@ -860,66 +813,10 @@ def union_sum(A: sp.spmatrix, B: sp.spmatrix) -> sp.csr_matrix:
     return out
 
 
-#: MKL's code of its sequential threading layer (mkl_set_threading_layer: INTEL 0, SEQUENTIAL 1, GNU 3)
-MKL_THREADING_SEQUENTIAL = 1
-
-
-def require_sequential_mkl(lib) -> None:
-    """Put MKL (``lib``, the loaded ``libmkl_rt``) on its sequential threading layer for an
-    out-of-core solve, or raise SolverError if the process has already called MKL on a threaded one.
-
-    MKL chooses its layer at its first call in a process and keeps it (``MKL_Set_Threading_Layer``
-    returns the layer in effect).  Intel requires the OpenMP thread count of PARDISO's out-of-core
-    mode unchanged from the analysis to the solution ("How to use OOC PARDISO").  On a busy machine
-    the threaded out-of-core factorisation came out wrong although graspdef held MKL's thread count
-    (``MKL_Set_Num_Threads_Local``; MKL's dynamic adjustment of its threads to the load is a
-    suspect, not shown): the 12 x 12 plate's factor, every time the same way (a residual of
-    4.96e-2, caught by the solve's check), in about 1 of 60 runs of
-    tests/solve/test_kkt_out_of_core.py in two loops side by side -- even with one handle per
-    process -- and in none of 295 runs on the sequential layer.  Later (2026-11-27, ninth session)
-    wrong factors came on the sequential layer too, of other values, with Python objects overwritten
-    in the same kind of process: 4 failures in 2,941 out-of-core processes (docs/speed.md, "Out of core"),
-    so this layer is not the cure of that fault; it stays because the threaded failures came more
-    often (3 in ~205 runs of the file, each several out-of-core processes).  In-core
-    PARDISO keeps the threaded layer, so one process cannot hold both: an out-of-core solve needs a
-    process that has not called MKL before (as ``graspdef solve --backend pardiso-ooc`` is)."""
-    layer = int(lib.MKL_Set_Threading_Layer(ctypes.c_int(MKL_THREADING_SEQUENTIAL)))
-    if layer != MKL_THREADING_SEQUENTIAL:
-        raise SolverError(
-            "PARDISO out of core (backend 'pardiso-ooc') runs on MKL's sequential threading layer, which "
-            "must be chosen before MKL's first call; this process has already called MKL on its threaded "
-            f"layer (code {layer}, e.g. an in-core PARDISO solve): run the out-of-core solve in a process "
-            "of its own, e.g. graspdef solve PROBLEM --backend pardiso-ooc")
-
-
-#: whether this process has created its out-of-core PARDISO handle (require_one_ooc_handle)
-_ooc_handle_created = False
-
-
-def require_one_ooc_handle() -> None:
-    """Allow the process's first out-of-core PARDISO handle; refuse any further one (SolverError).
-
-    MKL 2026.2's out-of-core mode keeps state of its own across handles, and processes that made a
-    second handle after freeing the first corrupted memory: in standalone processes, 3 of 417 with
-    two to ten handles each (the cantilever's path re-analysed on a fresh handle: 2 segmentation
-    faults in 281; ten plate solves on ten handles: an ``AttributeError`` inside pypardiso in 136)
-    against 0 of 1,036 with one handle (900 plate solves; ten factorisations on one handle, 136),
-    and in 3 of 260 processes that re-created a handle after error -9 (docs/speed.md, "Out of core").  One
-    handle per process, analysed once: a pattern change inside the analysed pattern is factorised
-    on it, any other is refused, as are PARDISO's fallback settings (a fresh handle each).  State
-    of the process, like MKL's own: ``graspdef solve --backend pardiso-ooc`` is one process."""
-    global _ooc_handle_created
-    if _ooc_handle_created:
-        raise SolverError("PARDISO out of core (backend 'pardiso-ooc') allows one solver per process: a second "
-                          "one in the same process corrupted memory (MKL 2026.2; docs/speed.md, 'Out of core'); run each "
-                          "out-of-core solve in a process of its own, e.g. graspdef solve PROBLEM --backend pardiso-ooc")
-    _ooc_handle_created = True
-
-
 def ooc_path(folder: str) -> str:
     """MKL_PARDISO_OOC_PATH for a folder: the folder itself, without a trailing separator (MKL adds
     "/mkl_pardiso"; a path ending in a separator makes MKL 2026.2 write one byte past a heap buffer,
-    :meth:`KKTSystem._ooc_environment`)."""
+    KKTSystem._ooc_env)."""
     path = folder.rstrip(os.sep)
     if not path:
         raise SolverError(f"PARDISO out of core needs a folder other than the file system's root, got {folder!r}")

@@ -4,12 +4,12 @@ does not fit (README "Speed": the 100k pinched cylinder; docs/speed.md, "Out of 
 1e-10, the residual check passes, the inertia is that of the stable state; the files and the
 process's environment are left as they were.
 
-Each check runs in a fresh interpreter: a process holds one out-of-core solver, on MKL's sequential
-layer, and no in-core PARDISO solver (graspdef.solve.sparse.require_one_ooc_handle and
-require_sequential_mkl: a second out-of-core handle corrupted memory, and MKL's threads gave a
-wrong out-of-core factor on a busy machine, together about 1 in 75 runs of this file until
-2026-11-27; docs/speed.md, "Out of core").  Those interpreters end with os._exit once their answer is
-printed, as ``graspdef solve`` does after an out-of-core solve (graspdef.cli.console).
+Every out-of-core handle lives in a worker process of its own (graspdef.solve.pardiso_ooc): MKL's
+out-of-core mode corrupts the memory of the process it runs in, about 1 in 700 processes
+(docs/speed.md, "Out of core"; until 2026-12-07 in these tests' own interpreters, which made this
+file fail about once in 120 runs, last in CI on 2026-12-07).  The checks that used to run in fresh
+interpreters still do (``_run``); the worker's own checks run in the test process, which no longer
+holds MKL's out-of-core state.
 
 The references are SuperLU's.  The right-hand sides are the plate's own load (a centre point
 load)."""
@@ -27,15 +27,6 @@ from graspdef.solve.sparse import pardiso_available
 
 ROOT = Path(__file__).resolve().parents[2]
 needs_pardiso = pytest.mark.skipif(not pardiso_available(), reason="PARDISO (pypardiso + MKL) not installed")
-#: ``graspdef solve --backend pardiso-ooc`` end to end: 9 of the 10 failures of this file in about
-#: 1,050 runs of it in two loops side by side (2026-11-26 to 27; the tenth's test was not recorded)
-#: came in these two tests -- a wrong factor caught by its check, a path refused at its first step, a
-#: Python object overwritten, a wrong "completed" answer; then (2026-11-27, ninth session, MKL on its
-#: sequential layer, one handle) 4 failures in 2,941 out-of-core processes, these tests' and standalone
-#: ones: memory corruption in MKL's out-of-core mode, cause not found; not in `make test` until it is
-#: (docs/speed.md, "Out of core"); `make test-ooc` runs them
-OOC_CLI = pytest.mark.ooc_cli
-
 PRELUDE = """
 import json, os, sys
 import numpy as np
@@ -59,10 +50,7 @@ out = {}
 
 def _run(tmp_path, body: str) -> dict:
     """Run PRELUDE + body in a fresh interpreter (the repository on its path); body fills ``out``."""
-    # the process ends with os._exit once its answer is printed: MKL's out-of-core mode has been seen to
-    # crash a process at exit (1 of 60 with two such solvers) after correct results -- what is checked
-    # here is the solutions, the folders and the environment (graspdef.cli.console does the same)
-    code = PRELUDE + body + "\nprint(json.dumps(out), flush=True)\nos._exit(0)\n"
+    code = PRELUDE + body + "\nprint(json.dumps(out), flush=True)\n"
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     r = subprocess.run([sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True, env=env,
                        cwd=tmp_path, timeout=300, check=False)
@@ -147,19 +135,19 @@ def test_the_out_of_core_folder_is_given_without_a_trailing_separator(tmp_path):
     """MKL 2026.2 writes one byte past a heap buffer when MKL_PARDISO_OOC_PATH ends in a separator
     (valgrind's memcheck: an invalid write of size 1 in ``mkl_pds_lp64_pardiso_ooc_read_cfg_file``
     for "/tmp/x/", none for "/tmp/x"); that byte corrupts whatever the heap has next to it.  Every
-    PARDISO call of an out-of-core system sees its folder without the separator, an existing
-    folder, where MKL puts its files (mkl_pardiso_*.bin).  (The failures that remained after this
-    fix had two other causes: test_one_out_of_core_solver_per_process and
-    test_out_of_core_runs_on_mkls_sequential_layer_and_only_there.)"""
+    PARDISO call of an out-of-core system gives its worker the folder without the separator, an
+    existing folder, where MKL puts its files (mkl_pardiso_*.bin); the calling process's own
+    environment is not touched."""
     out = _run(tmp_path, """
+from graspdef.solve.pardiso_ooc import OOCPardiso
 seen = []
-real = sparse.environment
-def spy(values):
-    path = values.get("MKL_PARDISO_OOC_PATH")
-    if path is not None:
-        seen.append([path, os.path.isdir(path), sorted(os.listdir(path))])
-    return real(values)
-sparse.environment = spy
+real = OOCPardiso.call
+def spy(self, phase, U, b, env):
+    path = env["MKL_PARDISO_OOC_PATH"]
+    x = real(self, phase, U, b, env)
+    seen.append([path, os.path.isdir(path), sorted(os.listdir(path)), os.environ.get("MKL_PARDISO_OOC_PATH")])
+    return x
+OOCPardiso.call = spy
 K, C, g, f = system(plate(8))
 with KKTSystem(C, "pardiso-ooc") as kkt:
     kkt.factor(K)
@@ -168,130 +156,158 @@ out["seen"] = seen
 """)
     seen = out["seen"]
     assert len(seen) >= 3                                     # analysis, factorisation, solution
-    assert all(not p.endswith(os.sep) and is_dir for p, is_dir, _ in seen), seen
-    assert any(name.startswith("mkl_pardiso_") for _, _, files in seen for name in files), seen
+    assert all(not p.endswith(os.sep) and is_dir and own is None for p, is_dir, _, own in seen), seen
+    assert any(name.startswith("mkl_pardiso_") for _, _, files, _ in seen for name in files), seen
+
+
+def _plate_system(n: int = 8):
+    """The n x n plate's K, C, g, f, and SuperLU's displacements (the reference)."""
+    import numpy as np
+
+    from graspdef.problem.config import load_problem
+    from graspdef.solve.linear import rest_stiffness
+    from graspdef.solve.sparse import KKTSystem
+    from graspdef.testing import plate_problem
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "plate.toml"
+        path.write_text(plate_problem(n=n))
+        pr = load_problem(path).problem
+    K = rest_stiffness(pr)
+    C, _, g = pr.constraints(with_targets=True)
+    f = pr.load_vector()
+    with KKTSystem(C, "superlu") as ref:
+        ref.factor(K)
+        u_ref = ref.solve(f, g)[0]
+    return K, C, g, f, np.asarray(u_ref)
+
+
+def _off(u, u_ref) -> float:
+    import numpy as np
+
+    return float(np.abs(u - u_ref).max() / np.abs(u_ref).max())
 
 
 @needs_pardiso
-def test_out_of_core_runs_on_mkls_sequential_layer_and_only_there(tmp_path):
-    """An out-of-core solve puts MKL on its sequential threading layer (asked for GNU OpenMP
-    afterwards, MKL answers with the layer in effect, 1, and one thread); in a process whose MKL
-    already runs threaded (an in-core PARDISO solve first) an out-of-core system is refused with one
-    line before any out-of-core call (graspdef.solve.sparse.require_sequential_mkl: threaded, the
-    out-of-core factor came out wrong about once in 60 runs of this file on a busy machine)."""
-    out = _run(tmp_path, """
-K, C, g, f = system(plate(8))
-with KKTSystem(C, "pardiso-ooc") as kkt:
-    kkt.factor(K)
-    out["rel"] = kkt.solve(f, g)[2]
-    lib = kkt._solver.libmkl
-    out["layer"] = int(lib.MKL_Set_Threading_Layer(3))
-    out["threads"] = int(lib.MKL_Get_Max_Threads())
-""")
-    assert out["layer"] == 1 and out["threads"] == 1 and out["rel"] <= 1e-8
-    out = _run(tmp_path, """
-import tempfile
-from graspdef.errors import SolverError
-tempfile.tempdir = sys.argv[1]                  # an out-of-core folder would go here
-K, C, g, f = system(plate(8))
-with KKTSystem(C, "pardiso") as kkt:
-    kkt.factor(K)
-    out["rel"] = kkt.solve(f, g)[2]
-try:
+def test_out_of_core_runs_in_a_sequential_worker_beside_in_core_solvers(tmp_path, monkeypatch):
+    """An out-of-core system's PARDISO handle lives in a worker process on MKL's sequential layer
+    with one thread (graspdef.solve.pardiso_ooc): the test process, whose MKL runs threaded after
+    an in-core solve, holds in-core and out-of-core systems side by side -- two out-of-core ones at
+    once and a third after they closed -- each in a worker of its own, each answer SuperLU's to
+    1e-10 with the inertia of the stable state.  Until 2026-12-07 the calling process itself had to
+    be on the sequential layer with one out-of-core handle for its life."""
+    import tempfile
+
+    from graspdef.solve.sparse import KKTSystem, OOC_PREFIX
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))    # the out-of-core folders go here
+    K, C, g, f, u_ref = _plate_system()
+    with KKTSystem(C, "pardiso") as core:
+        core.factor(K)
+        assert _off(core.solve(f, g)[0], u_ref) <= 1e-10
+        threads = int(core._solver.libmkl.MKL_Get_Max_Threads())
+        pids = []
+        with KKTSystem(C, "pardiso-ooc") as a, KKTSystem(C, "pardiso-ooc") as b:
+            for kkt in (a, b):
+                kkt.factor(K)
+                assert kkt._solver.layer == 1 and kkt._solver.threads == 1
+                assert kkt.n_negative == kkt.m
+                pids.append(kkt._solver.pid)
+            for kkt in (b, a):
+                assert _off(kkt.solve(f, g)[0], u_ref) <= 1e-10
+        with KKTSystem(C, "pardiso-ooc") as c:
+            c.factor(K)
+            assert _off(c.solve(f, g)[0], u_ref) <= 1e-10
+            pids.append(c._solver.pid)
+        assert len(set(pids + [os.getpid()])) == 4
+        assert int(core._solver.libmkl.MKL_Get_Max_Threads()) == threads
+        assert _off(core.solve(f, g)[0], u_ref) <= 1e-10
+    assert not [n for n in os.listdir(tmp_path) if n.startswith(OOC_PREFIX)]
+
+
+@needs_pardiso
+def test_a_failed_worker_is_replaced_and_a_second_failure_is_one_line(tmp_path, monkeypatch):
+    """A worker killed between the factorisation and the solve (as a corrupted process ends) is
+    replaced by a fresh one, which analyses and factorises the matrix again: the solve gives
+    SuperLU's answer to 1e-10, one restart counted.  A worker that raises (here: an iparm index
+    PARDISO does not have, sent to every worker) is replaced once; the second failure is a
+    SolverError of one line, and the system still closes and removes its folder.  A worker that
+    cannot start is one line too."""
+    import signal
+    import tempfile
+
+    from graspdef.errors import SolverError
+    from graspdef.solve import pardiso_ooc
+    from graspdef.solve.sparse import KKTSystem
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    K, C, g, f, u_ref = _plate_system()
     with KKTSystem(C, "pardiso-ooc") as kkt:
         kkt.factor(K)
-    out["error"] = None
-except SolverError as exc:
-    out["error"] = str(exc)
-out["left"] = sorted(n for n in os.listdir(sys.argv[1]) if n.startswith("graspdef_pardiso_ooc_"))
-""")
-    assert out["rel"] <= 1e-8
-    assert "sequential threading layer" in out["error"] and "process of its own" in out["error"], out
-    assert "\n" not in out["error"] and out["left"] == []
-
-
-@needs_pardiso
-def test_one_out_of_core_solver_per_process(tmp_path):
-    """A second out-of-core system in a process is refused with one line before it calls PARDISO
-    (MKL 2026.2 corrupted memory in processes that made a second out-of-core handle:
-    graspdef.solve.sparse.require_one_ooc_handle), after the first was closed as well as beside it;
-    the first one's solution stands, and no folder is left behind."""
-    out = _run(tmp_path, """
-import tempfile
-from graspdef.errors import SolverError
-tempfile.tempdir = sys.argv[1]                  # the out-of-core folders go here
-K, C, g, f = system(plate(8))
-with KKTSystem(C, "superlu") as ref:
-    ref.factor(K)
-    u_ref = ref.solve(f, g)[0]
-first = KKTSystem(C, "pardiso-ooc")
-first.factor(K)
-u = first.solve(f, g)[0]
-out["du"] = float(np.abs(u - u_ref).max() / np.abs(u_ref).max())
-out["errors"] = []
-for close_first in (False, True):
-    if close_first:
-        first.close()
-    try:
-        with KKTSystem(C, "pardiso-ooc") as kkt:
+        first = kkt._solver.pid
+        os.kill(first, signal.SIGKILL)
+        u, _, rel = kkt.solve(f, g)
+        assert _off(u, u_ref) <= 1e-10 and rel <= 1e-8
+        assert kkt._solver.restarts == 1 and kkt._solver.pid != first
+        kkt._solver._settings[65] = 1                       # iparm has 64 entries: the worker raises
+        with pytest.raises(SolverError) as exc:
+            kkt.solve(f, g)
+        assert "2 worker processes failed" in str(exc.value) and "\n" not in str(exc.value)
+        assert "IndexError" in str(exc.value)
+        folder = kkt._ooc_dir
+    assert not os.path.exists(folder)
+    monkeypatch.setattr(pardiso_ooc, "WORKER", [sys.executable, "-c", "import sys; sys.exit(3)"])
+    with KKTSystem(C, "pardiso-ooc") as kkt:
+        with pytest.raises(SolverError, match="ended with status 3 before it was ready") as exc:
             kkt.factor(K)
-        out["errors"].append(None)
-    except SolverError as exc:
-        out["errors"].append(str(exc))
-out["left"] = sorted(n for n in os.listdir(sys.argv[1]) if n.startswith("graspdef_pardiso_ooc_"))
-""")
-    assert out["du"] <= 1e-10
-    for e in out["errors"]:
-        assert e is not None and "one solver per process" in e and "process of its own" in e and "\n" not in e, out
-    assert out["left"] == []
+        assert "\n" not in str(exc.value)
 
 
 @needs_pardiso
-def test_out_of_core_keeps_its_one_analysis(tmp_path):
-    """One analysis per out-of-core system: a matrix whose pattern lies inside the analysed one (a
-    Newton tangent with an entry fewer) is factorised on it and solved to SuperLU's answer; one
-    with an entry outside it is refused with one line naming both counts; PARDISO's fallback
-    settings (a fresh handle each) are not tried out of core."""
-    out = _run(tmp_path, """
-from graspdef.errors import SolverError
-import scipy.sparse as sp
-K, C, g, f = system(plate(8))
-K = K.tocsr()
-K.sort_indices()
-# an off-diagonal pair dropped (symmetric): a pattern inside K's
-i = 0
-j = int(K.indices[K.indptr[0]:K.indptr[1]][-1])
-fewer = K.tolil()
-fewer[i, j] = 0.0
-fewer[j, i] = 0.0
-fewer = fewer.tocsr()
-fewer.eliminate_zeros()
-with KKTSystem(C, "superlu") as ref:
-    ref.factor(fewer)
-    u_ref = ref.solve(f, g)[0]
-with KKTSystem(C, "pardiso-ooc") as kkt:
-    kkt.factor(K)
-    analysed = kkt._map
-    kkt.factor(fewer)
-    out["same_analysis"] = kkt._map is analysed
-    u, _, out["rel"] = kkt.solve(f, g)
-    out["du"] = float(np.abs(u - u_ref).max() / np.abs(u_ref).max())
-    out["retry"] = kkt.retry_robust()
+def test_out_of_core_keeps_its_analysis_for_a_pattern_inside_it():
+    """A matrix whose pattern lies inside the analysed one (a Newton tangent with an entry fewer) is
+    factorised on that analysis, by the same worker, and solved to SuperLU's answer; one with an
+    entry outside it is analysed by a fresh worker (a second analysis on one out-of-core handle
+    crashed the process) and solved to SuperLU's answer; PARDISO's fallback settings are tried out
+    of core too (a fresh worker), to the same answer.  Until 2026-12-07 both were refused."""
+    import numpy as np
+    import scipy.sparse as sp
+
+    from graspdef.solve import sparse
+    from graspdef.solve.sparse import KKTSystem
+
+    K, C, g, f, _ = _plate_system()
+    K = K.tocsr()
+    K.sort_indices()
+    j = int(K.indices[K.indptr[0]:K.indptr[1]][-1])          # an off-diagonal pair dropped: inside K's pattern
+    fewer = K.tolil()
+    fewer[0, j] = 0.0
+    fewer[j, 0] = 0.0
+    fewer = fewer.tocsr()
+    fewer.eliminate_zeros()
     n = K.shape[0]
     corner = sp.coo_matrix(([1e-3, 1e-3], ([0, n - 1], [n - 1, 0])), shape=K.shape)
-    more = sparse.union_sum(K, corner)          # K's pattern (its explicit zeros kept) and two entries
-    try:
+    more = sparse.union_sum(K, corner)                      # K's pattern (its explicit zeros kept) and two entries
+    assert more.nnz == K.nnz + 2
+    refs = {}
+    for name, M in (("fewer", fewer), ("more", more)):
+        with KKTSystem(C, "superlu") as ref:
+            ref.factor(M)
+            refs[name] = np.asarray(ref.solve(f, g)[0])
+    with KKTSystem(C, "pardiso-ooc") as kkt:
+        kkt.factor(K)
+        analysed, pid = kkt._map, kkt._solver.pid
+        kkt.factor(fewer)
+        assert kkt._map is analysed and kkt._solver.pid == pid
+        u, _, rel = kkt.solve(f, g)
+        assert rel <= 1e-8 and _off(u, refs["fewer"]) <= 1e-10
         kkt.factor(more)
-        out["error"] = None
-    except SolverError as exc:
-        out["error"] = str(exc)
-    out["nnz"] = [int(K.nnz), int(more.nnz)]
-""")
-    assert out["same_analysis"] and out["rel"] <= 1e-8 and out["du"] <= 1e-10, out
-    assert out["retry"] is False
-    assert out["error"] is not None and "sparsity pattern changed" in out["error"], out
-    assert out["nnz"][1] == out["nnz"][0] + 2
-    assert f"{out['nnz'][0]:,}" in out["error"] and f"{out['nnz'][1]:,}" in out["error"]
+        assert kkt._map is not analysed and kkt._solver.pid != pid
+        assert _off(kkt.solve(f, g)[0], refs["more"]) <= 1e-10
+        pid = kkt._solver.pid
+        assert kkt.retry_robust() and kkt.variant == 1 and kkt._solver.pid != pid
+        assert _off(kkt.solve(f, g)[0], refs["more"]) <= 1e-10
 
 
 def test_ooc_path_drops_the_trailing_separator():
@@ -315,7 +331,6 @@ def _solve_cli(tmp_path, path, backend: str) -> dict:
     return json.loads((tmp_path / backend / "result.json").read_text())
 
 
-@OOC_CLI
 @needs_pardiso
 def test_graspdef_solve_out_of_core(tmp_path):
     """``graspdef solve --backend pardiso-ooc`` (a process of its own): the run folder records the
@@ -332,7 +347,6 @@ def test_graspdef_solve_out_of_core(tmp_path):
     assert w["pardiso-ooc"] == pytest.approx(w["pardiso"], rel=1e-10, abs=0)
 
 
-@OOC_CLI
 @needs_pardiso
 def test_graspdef_solve_out_of_core_follows_a_nonlinear_path(tmp_path):
     """A nonlinear path out of core (the cantilever rolled up by an end moment, to 0.1 of it in two
@@ -340,7 +354,9 @@ def test_graspdef_solve_out_of_core_follows_a_nonlinear_path(tmp_path):
     tangents used to fill the flat plate's exact zeros after the first step (31,203 -> 55,359
     non-zeros), and a second analysis crashed the process on the same handle (segmentation fault)
     and, on a fresh handle, corrupted memory in 2 of 281 processes; now the tangent keeps one
-    pattern from the start (test_a_flat_shells_tangent_keeps_its_pattern) and one handle serves."""
+    pattern from the start (test_a_flat_shells_tangent_keeps_its_pattern) and one handle serves.
+    Until 2026-12-07 this test and the one above ran outside ``make test`` (MKL's out-of-core memory
+    corruption in the solving process itself failed them about once in 120 runs)."""
     text = (ROOT / "benchmarks" / "nonlinear" / "cantilever_moment.toml").read_text()
     path = tmp_path / "cantilever.toml"
     path.write_text(text.replace("steps = 20", "steps = 2\nmax_load = 0.1"))
