@@ -7,8 +7,10 @@ K is symmetric positive semi-definite (rigid modes), C removes them, so the KKT 
 symmetric indefinite with exactly m negative eigenvalues when K is positive definite on the null
 space of C.  Backends: MKL PARDISO through pypardiso (symmetric indefinite LDL^T with inertia; the
 default, see README for the measurements) and SciPy's SuperLU (fallback, no inertia).  Backend
-"pardiso-ooc" is PARDISO out of core: the factor is written to files in a temporary folder (removed
-when the system is closed) and only :data:`OOC_CORE_MB` of it is held in memory at a time -- for
+"pardiso-ooc" is PARDISO out of core, in a worker process of its own (graspdef.solve.pardiso_ooc:
+MKL's out-of-core mode corrupts the memory of the process it runs in, at random): the factor is
+written to files in a temporary folder (removed when the system is closed) and only
+:data:`OOC_CORE_MB` of it is held in memory at a time -- for
 problems whose in-core factor does not fit (the 100k pinched cylinder's is 2.8 GB in double, 1.1 GB
 in single precision).  ``precision`` "mixed" (:class:`KKTSystem`): a single-precision factor whose
 solves are refined in double to a double solve's backward error.
