@@ -29,6 +29,7 @@ the system is closed, or by itself when the calling process has gone.
 """
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import socket
@@ -193,14 +194,11 @@ class OOCPardiso:
                 x = np.empty(b.size, b.dtype)
                 conn.recv_bytes_into(x)
         except (EOFError, OSError) as exc:
-            status = self._proc.poll() if self._proc is not None else None
-            if status is None and self._proc is not None:
-                try:
-                    status = self._proc.wait(WORKER_EXIT_S)
-                except subprocess.TimeoutExpired:
-                    status = None
-            raise _WorkerLost(f"it ended with status {status}" if status is not None
-                              else f"its connection failed: {type(exc).__name__}") from None
+            try:
+                status = self._proc.wait(WORKER_EXIT_S)
+            except subprocess.TimeoutExpired:
+                raise _WorkerLost(f"its connection failed: {type(exc).__name__}") from None
+            raise _WorkerLost(f"it ended with status {status}") from None
         if send_matrix:
             self._held = U
         if reply.get("iparm") is not None:
@@ -234,10 +232,9 @@ def _serve(fd: int, mtype: int) -> None:
         except (EOFError, OSError):
             return                                  # the calling process has gone
         if head["op"] == "exit":
-            try:
+            with contextlib.suppress(Exception):    # the process ends either way
                 solver.free_memory(everything=True)
-            finally:
-                return
+            return
         try:
             if head["matrix"] is not None:
                 dtype, n1, nnz = head["matrix"]
