@@ -19,6 +19,12 @@ The ahead-of-time module loads like any extension (a few ms) and needs no numba 
 Large problems keep the parallel JIT build (2 cores: the shell's Hessian assembly about 1.8x
 faster), where numba's fixed cost is small against the solve.
 
+The ahead-of-time exports release the GIL while they run (as ``njit(nogil=True)`` would: pycc's
+wrappers are built with numba's ``release_gil`` flag), so a term whose work is in such kernels can
+be evaluated in a thread beside the other terms' Python code (graspdef.solve.equilibrium,
+:func:`ahead_of_time`); the pad grasp's shell Hessian, 10 ms of a 28 ms tangent, then overlaps
+the contact terms'.
+
 Both builds compute the same numbers: the kernels' parallel loops write disjoint outputs (no
 reductions across iterations) and nothing is compiled with fastmath, so serial and parallel,
 ahead-of-time and JIT agree to the bit (``tests/test_compiled.py`` and ``graspdef bench kernels``
@@ -103,6 +109,14 @@ class Kernel:
         (when the module is there): a serial kernel always, a parallel one up to ``per_face``
         :data:`SERIAL_MAX`."""
         return not self.parallel or work <= self.per_face * SERIAL_MAX
+
+    def ahead_of_time(self, work: int) -> bool:
+        """Whether a call with this much work (``args[work].shape[0]``) runs the ahead-of-time
+        build -- serial, with the GIL released -- when its arguments have an exported signature's
+        types."""
+        if self._aot is None:
+            self._aot = _aot_exports(self)
+        return bool(self._aot) and self.serial(work)
 
     @property
     def jit(self):
@@ -357,6 +371,27 @@ def builds_used() -> dict:
             "jit": sorted(n for n, ks in _REGISTRY.items() if any(k._jit is not None for k in ks))}
 
 
+@contextlib.contextmanager
+def _gil_released_exports():
+    """pycc compiles its exports with numba's compiler flags made in ``numba.pycc.compiler``; with
+    ``release_gil`` set there, each export's Python wrapper releases the GIL around the kernel, as
+    numba's ``nogil=True`` does for the JIT (the kernels touch no Python object).  The flag class
+    is swapped for the build only."""
+    from numba.core.compiler import Flags
+    from numba.pycc import compiler as pycc_compiler
+
+    class GilReleased(Flags):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            self.release_gil = True
+
+    saved, pycc_compiler.Flags = pycc_compiler.Flags, GilReleased
+    try:
+        yield
+    finally:
+        pycc_compiler.Flags = saved
+
+
 def build(out_dir: Path = _HERE, verbose: bool = False) -> Path:
     """Compile every kernel's ``aot`` signatures into ``out_dir/_aot*.so`` (numba's pycc; needs a C
     compiler) and write the source stamp ``_aot.json`` beside it; returns the module's path."""
@@ -382,7 +417,8 @@ def build(out_dir: Path = _HERE, verbose: bool = False) -> Path:
                     exports[k.export_name(i)] = [_arg_spec(t) for t in sig.args]
         stamp_file = Path(out_dir) / f"{AOT_NAME}.json"
         stamp_file.unlink(missing_ok=True)
-        cc.compile()
+        with _gil_released_exports():
+            cc.compile()
     so = next(Path(out_dir).glob(f"{AOT_NAME}.*.so"))
     stamp_file.write_text(json.dumps({"source_sha256": source_stamp(), "cpu": cpu_name(), "exports": exports}) + "\n")
     return so

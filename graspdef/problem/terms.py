@@ -18,6 +18,10 @@ Each term is set up completely when it is built (from a shell, by its specificat
   :class:`graspdef.shell.region.Region` -- a CSR matrix (3|R|, 3n) on the region's pattern, or None
   where the term has no Hessian -- and the term's rank-one parts [(c, v)] (v whole); computed on
   the region's faces only, for the path's local corrections (a term without it turns them off);
+* ``concurrent()`` (optional, False by default): True when ``evaluate`` may run in a thread beside
+  the other terms' -- its work is in code that releases the GIL (graspdef.compiled's ahead-of-time
+  kernels), it shares no mutable state with them, and it launches no parallel region of numba's
+  (:class:`graspdef.solve.equilibrium.Equilibrium` then evaluates it so: the shell's elastic term);
 * ``remedy`` (optional, None by default): for a term that is not convex by itself -- e.g. a Nitsche
   edge term, whose consistency part is bounded only by its penalty -- a sentence naming the
   setting that restores it; a path that stalls on a mode that such a term makes soft says so
@@ -77,6 +81,9 @@ class TermBase:
     def record(self, x: np.ndarray) -> dict:
         return {}
 
+    def concurrent(self) -> bool:
+        return False
+
 
 #: ``hessian_rows`` of a term without a Hessian (dead loads): no rows, no rank-one parts
 NO_ROWS = (None, ())
@@ -91,6 +98,14 @@ class ShellElastic(TermBase):
         from ..shell.energy import ShellEnergy
 
         self.energy = ShellEnergy(shell)
+
+    def concurrent(self) -> bool:
+        """In a thread of its own when every kernel runs ahead of time (ShellEnergy.concurrent);
+        the Hessian's block pattern, shared with other terms, is then built here, before any thread."""
+        if not self.energy.concurrent():
+            return False
+        self.energy.pattern
+        return True
 
     def evaluate(self, x: np.ndarray, lam: float, order: int = 2, u: np.ndarray | None = None) -> TermValue:
         if order == 0:

@@ -168,6 +168,21 @@ class ShellEnergy:
             self._pattern = block_pattern(self.shell)
         return self._pattern
 
+    def concurrent(self) -> bool:
+        """Whether an evaluation runs in serial code only -- every kernel on its ahead-of-time
+        build, which releases the GIL (graspdef.compiled), the material's density there or in
+        numpy -- so that it may run in a thread beside other terms' evaluations: never where a
+        kernel would take numba's parallel build (two threads launching parallel regions at once
+        is not safe on every numba threading layer)."""
+        serial_at = getattr(self.shell.material, "serial_at", None)      # (numpy materials: always)
+        for gd, r in zip(self._groups, self.shell.rest):
+            nf = gd.stencils.shape[0]
+            if not (point_strains.ahead_of_time(nf) and assemble_elements.ahead_of_time(nf)):
+                return False
+            if serial_at is not None and not serial_at(int(np.prod(r.weights.shape))):
+                return False
+        return True
+
     def _chunks(self):
         for g, r in zip(self.shell.basis.groups, self.shell.rest):
             nf = len(g.faces)

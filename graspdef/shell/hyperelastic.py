@@ -197,6 +197,12 @@ class _ThicknessIntegrated:
         ``_kernels.density_points``: the numpy path is used)."""
         return None
 
+    def serial_at(self, n_points: int) -> bool:
+        """Whether :meth:`density` at ``n_points`` points runs serially -- numpy, or the compiled
+        kernel's ahead-of-time build, which releases the GIL -- and never numba's parallel build
+        (graspdef.shell.energy.ShellEnergy.concurrent)."""
+        return self._kind() is None or density_points.ahead_of_time(n_points)
+
     def density(self, s: np.ndarray, rest_inv: np.ndarray, thickness: np.ndarray):
         """Energy per unit rest mid-surface area and its derivatives with respect to ``s``.
 

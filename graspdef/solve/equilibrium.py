@@ -36,6 +36,7 @@ step's forcing tolerance, ``PathSolver.newton``), not to a double solve's backwa
 """
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,6 +49,12 @@ from ..problem.terms import EnergyTerm
 from ..shell.region import Region, vertex_rings
 from .krylov import gmres
 from .sparse import KKTSystem, RowSummary, row_summary, same_array, union_sum
+
+
+#: a term that may (``concurrent()``) is evaluated in a thread beside the others from this many control
+#: vertices on (the tennis ball's 642: a tangent 28 -> 18 ms, a gradient 6.1 -> 5.5 ms; a thread's
+#: start and join cost ~0.1 ms, which a smaller shell's overlap does not repay)
+CONCURRENT_MIN_VERTICES = 256
 
 
 def _add(A: sp.spmatrix, B: sp.spmatrix) -> sp.csr_matrix:
@@ -163,6 +170,11 @@ class Equilibrium:
         self._lowrank = None          # the rank-one terms' Woodbury parts on the last factor
         self._ahead = None            # a next solve's right-hand sides and their iterates (factor)
         self.n_local = 0              # local corrections (local_step)
+        # the term evaluated in a thread beside the others (EnergyTerm.concurrent), or None
+        self.concurrent = None
+        if len(self.terms) > 1 and shell.n_control >= CONCURRENT_MIN_VERTICES:
+            self.concurrent = next((i for i, t in enumerate(self.terms)
+                                    if getattr(t, "concurrent", None) is not None and t.concurrent()), None)
         # vertices in support rows of their own (not the dense surface-mean rows): never in a region
         self._held = np.zeros(problem.shell.n_control, bool)
         if self.m:
@@ -190,8 +202,7 @@ class Equilibrium:
         rank_one: list = []
         q = np.zeros(self.n)
         parts = [] if keep_terms else None
-        for t in self.terms:
-            v = t.evaluate(x, lam, order, u)
+        for t, v in zip(self.terms, self._values(x, lam, order, u)):
             if parts is not None:
                 parts.append(v)
             E = v.value if E is None else E + v.value
@@ -212,6 +223,33 @@ class Equilibrium:
             self.floor = floor
         self.n_hessians += order == 2
         return State(float(E), grad, H, rank_one, q, internal, floor, rows=rows, terms=parts)
+
+    def _values(self, x: np.ndarray, lam: float, order: int, u: np.ndarray) -> list:
+        """Every term's TermValue, in the terms' order; the :attr:`concurrent` term's from a thread
+        of its own while this one evaluates the others (its kernels release the GIL), joined before
+        anything returns or raises.  The values and their sum in :meth:`evaluate` are the same to
+        the bit either way: each term computes alone, and the sum keeps the terms' order."""
+        c = self.concurrent
+        if c is None:
+            return [t.evaluate(x, lam, order, u) for t in self.terms]
+        out: dict = {}
+
+        def run():
+            try:
+                out["value"] = self.terms[c].evaluate(x, lam, order, u)
+            except BaseException as exc:                 # (re-raised by the calling thread)
+                out["error"] = exc
+
+        worker = threading.Thread(target=run, name="graspdef-term", daemon=True)
+        worker.start()
+        try:
+            vals = [None if i == c else t.evaluate(x, lam, order, u) for i, t in enumerate(self.terms)]
+        finally:
+            worker.join()
+        if "error" in out:
+            raise out["error"]
+        vals[c] = out["value"]
+        return vals
 
     def commit(self, u: np.ndarray) -> None:
         """Tell the state-tracking terms (edge rotations) that ``u`` is converged."""
