@@ -13,23 +13,33 @@ from ..compiled import kernel
 from ..shell._kernels import sorted_search
 
 
-@kernel(aot=("Tuple((f8[::1], f8[:,::1], f8[::1], f8[::1]))(f8[:,::1], f8[::1], f8[::1], f8[:,::1], f8[::1], f8, f8[::1])",))
-def box_distance(P, shift, c, R, h, rounding, e):
-    """Rounded box (centre c, axes = columns of R, inner half extents h, edge radius rounding):
-    phi (k,), outward unit normal n (k, 3), and along the unit vector e the derivatives of
-    phi(p - s e) in s: -n.e (k,) and e.H.e (k,)."""
-    k = P.shape[0]
-    phi = np.empty(k)
-    n = np.empty((k, 3))
-    d1 = np.empty(k)
-    d2 = np.empty(k)
+@kernel()
+def _log_barrier_terms(d, dhat):
+    """b'(d) and b''(d) of the log barrier b(d) = -(d - dh)^2 ln(d / dh), 0 < d < dh
+    (graspdef.contact.barrier.log_barrier: the same formulas)."""
+    r = d - dhat
+    lg = np.log(d / dhat)
+    return -2 * r * lg - r * r / d, -2 * lg - 4 * r / d + r * r / (d * d)
+
+
+@kernel()
+def _box_scan(P, shift, c, R, h, rounding, e, kw, dhat, phi, n, d1, d2):
+    """One pass over the points P - shift against the rounded box (:func:`box_distance`'s
+    arguments) that fills phi, n, d1, d2 when they have a row per point, and returns the log
+    barrier's sums of :func:`box_barrier_sums` with weights kw when kw has one (else zeros) --
+    the two kernels' one per-point code, without a call per point."""
+    fill = phi.shape[0] == P.shape[0]
+    add = kw.shape[0] == P.shape[0]
     el = np.empty(3)
     for j in range(3):
         el[j] = R[0, j] * e[0] + R[1, j] * e[1] + R[2, j] * e[2]
     loc = np.empty(3)
     q = np.empty(3)
     sm = np.empty(3)
-    for i in range(k):
+    gs = 0.0
+    gss = 0.0
+    dmin = np.inf
+    for i in range(P.shape[0]):
         for j in range(3):
             loc[j] = ((P[i, 0] - shift[0] - c[0]) * R[0, j] + (P[i, 1] - shift[1] - c[1]) * R[1, j]
                       + (P[i, 2] - shift[2] - c[2]) * R[2, j])
@@ -50,29 +60,65 @@ def box_distance(P, shift, c, R, h, rounding, e):
         if r < 1e-300:
             r = 1e-300
         ne = (sm[0] * el[0] + sm[1] * el[1] + sm[2] * el[2]) / r
-        phi[i] = (qmax if inside else r) - rounding
-        for a in range(3):
-            n[i, a] = (R[a, 0] * sm[0] + R[a, 1] * sm[1] + R[a, 2] * sm[2]) / r
-        d1[i] = -ne
-        d2[i] = (dee - ne * ne) / r
-    return phi, n, d1, d2
+        d = (qmax if inside else r) - rounding
+        if fill:
+            phi[i] = d
+            for a in range(3):
+                n[i, a] = (R[a, 0] * sm[0] + R[a, 1] * sm[1] + R[a, 2] * sm[2]) / r
+            d1[i] = -ne
+            d2[i] = (dee - ne * ne) / r
+        if add:
+            if d < dmin:
+                dmin = d
+            if d > 0.0 and d < dhat:
+                b1, b2 = _log_barrier_terms(d, dhat)
+                gs -= kw[i] * b1 * ne
+                gss += kw[i] * (b2 * ne * ne + b1 * (dee - ne * ne) / r)
+    return gs, gss, dmin
 
 
-@kernel(aot=("Tuple((f8[::1], f8[:,::1], f8[::1], f8[::1]))(f8[:,::1], f8[::1], f8[::1], f8[::1], f8, f8[::1])",))
-def capsule_distance(P, shift, a, b, radius, e):
-    """Capsule (segment a-b, radius): phi (k,), outward unit normal n (k, 3), and along the unit
-    vector e the derivatives of phi(p - s e) in s: -n.e (k,) and e.H.e (k,)."""
+@kernel(aot=("Tuple((f8[::1], f8[:,::1], f8[::1], f8[::1]))(f8[:,::1], f8[::1], f8[::1], f8[:,::1], f8[::1], f8, f8[::1])",))
+def box_distance(P, shift, c, R, h, rounding, e):
+    """Rounded box (centre c, axes = columns of R, inner half extents h, edge radius rounding):
+    phi (k,), outward unit normal n (k, 3), and along the unit vector e the derivatives of
+    phi(p - s e) in s: -n.e (k,) and e.H.e (k,)."""
     k = P.shape[0]
     phi = np.empty(k)
     n = np.empty((k, 3))
     d1 = np.empty(k)
     d2 = np.empty(k)
+    _box_scan(P, shift, c, R, h, rounding, e, np.empty(0), 1.0, phi, n, d1, d2)
+    return phi, n, d1, d2
+
+
+@kernel(aot=("UniTuple(f8, 3)(f8[:,::1], f8[::1], f8[::1], f8[::1], f8[:,::1], f8[::1], f8, f8[::1], f8)",))
+def box_barrier_sums(P, kw, shift, c, R, h, rounding, e, dhat):
+    """The condensed advance's sums for the log barrier of reach dhat over the points P (k, 3)
+    with weights kw (k,) against the rounded box advanced along e (arguments as
+    :func:`box_distance`'s): (B_s, B_ss, smallest gap) with B_s = sum kw b'(d) dd/ds and B_ss =
+    sum kw (b''(d) (dd/ds)^2 + b'(d) d2d/ds2) over the points with d < dhat (+inf and 0 when a
+    gap is <= 0; the smallest gap +inf for no point) -- without box_distance's arrays."""
+    gs, gss, dmin = _box_scan(P, shift, c, R, h, rounding, e, kw, dhat, np.empty(0), np.empty((0, 3)),
+                              np.empty(0), np.empty(0))
+    if dmin <= 0.0:
+        return np.inf, 0.0, dmin
+    return gs, gss, dmin
+
+
+@kernel()
+def _capsule_scan(P, shift, a, b, radius, e, kw, dhat, phi, n, d1, d2):
+    """:func:`_box_scan` for the capsule (:func:`capsule_distance`'s arguments)."""
+    fill = phi.shape[0] == P.shape[0]
+    add = kw.shape[0] == P.shape[0]
     ab = b - a
     L2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]
     ue = (ab[0] * e[0] + ab[1] * e[1] + ab[2] * e[2]) / np.sqrt(L2)
     ee = e[0] * e[0] + e[1] * e[1] + e[2] * e[2]
     v = np.empty(3)
-    for i in range(k):
+    gs = 0.0
+    gss = 0.0
+    dmin = np.inf
+    for i in range(P.shape[0]):
         t = 0.0
         for j in range(3):
             t += (P[i, j] - shift[j] - a[j]) * ab[j]
@@ -86,12 +132,45 @@ def capsule_distance(P, shift, a, b, radius, e):
         if r < 1e-300:
             r = 1e-300
         ne = (v[0] * e[0] + v[1] * e[1] + v[2] * e[2]) / r
-        for j in range(3):
-            n[i, j] = v[j] / r
-        phi[i] = r - radius
-        d1[i] = -ne
-        d2[i] = (ee - ne * ne - (ue * ue if (t > 0.0 and t < 1.0) else 0.0)) / r
+        d = r - radius
+        dd = (ee - ne * ne - (ue * ue if (t > 0.0 and t < 1.0) else 0.0)) / r
+        if fill:
+            for j in range(3):
+                n[i, j] = v[j] / r
+            phi[i] = d
+            d1[i] = -ne
+            d2[i] = dd
+        if add:
+            if d < dmin:
+                dmin = d
+            if d > 0.0 and d < dhat:
+                b1, b2 = _log_barrier_terms(d, dhat)
+                gs -= kw[i] * b1 * ne
+                gss += kw[i] * (b2 * ne * ne + b1 * dd)
+    return gs, gss, dmin
+
+
+@kernel(aot=("Tuple((f8[::1], f8[:,::1], f8[::1], f8[::1]))(f8[:,::1], f8[::1], f8[::1], f8[::1], f8, f8[::1])",))
+def capsule_distance(P, shift, a, b, radius, e):
+    """Capsule (segment a-b, radius): phi (k,), outward unit normal n (k, 3), and along the unit
+    vector e the derivatives of phi(p - s e) in s: -n.e (k,) and e.H.e (k,)."""
+    k = P.shape[0]
+    phi = np.empty(k)
+    n = np.empty((k, 3))
+    d1 = np.empty(k)
+    d2 = np.empty(k)
+    _capsule_scan(P, shift, a, b, radius, e, np.empty(0), 1.0, phi, n, d1, d2)
     return phi, n, d1, d2
+
+
+@kernel(aot=("UniTuple(f8, 3)(f8[:,::1], f8[::1], f8[::1], f8[::1], f8[::1], f8, f8[::1], f8)",))
+def capsule_barrier_sums(P, kw, shift, a, b, radius, e, dhat):
+    """:func:`box_barrier_sums` for the capsule (arguments as :func:`capsule_distance`'s)."""
+    gs, gss, dmin = _capsule_scan(P, shift, a, b, radius, e, kw, dhat, np.empty(0), np.empty((0, 3)),
+                                  np.empty(0), np.empty(0))
+    if dmin <= 0.0:
+        return np.inf, 0.0, dmin
+    return gs, gss, dmin
 
 
 # ------------------------------------------------------------------------------------------------

@@ -172,7 +172,8 @@ class FingerContact(TermBase):
         # start where the obstacle no longer reaches any sample (retracted by the overlap + dhat)
         s0 = min(0.0, float(phi.min()) - self._dh)
         self._s0 = s0 - 2 * self._dh - 0.5 * float(np.ptp(X @ self._e))
-        self._cond = ForceControlledAdvance(self._obs, self._e, self._dh, log_barrier, self.name, s0)
+        self._cond = ForceControlledAdvance(self._obs, self._e, self._dh, log_barrier, self.name, s0,
+                                            sums=getattr(self._obs, "log_barrier_sums", None))
         return self
 
     # ---- kinematics --------------------------------------------------------------------------

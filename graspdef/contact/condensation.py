@@ -19,16 +19,22 @@ class ForceControlledAdvance:
     """The condensed degree of freedom: the advance s [m] of an obstacle along the unit axis e
     where the barrier force of the samples equals F.  ``barrier``: the function b(d) -> (b, b',
     b'') of the gap; ``dhat``: its reach; ``s``: the starting advance (kept: each solve starts
-    from the last solution)."""
+    from the last solution); ``sums``: the obstacle's compiled (B_s, B_ss, smallest gap) of the
+    same barrier (e.g. ``RoundedBox.log_barrier_sums`` for graspdef.contact.barrier.log_barrier),
+    or None: :meth:`derivatives` then sums the barrier's values in numpy."""
 
-    def __init__(self, obstacle, e: np.ndarray, dhat: float, barrier, name: str, s: float = 0.0):
+    def __init__(self, obstacle, e: np.ndarray, dhat: float, barrier, name: str, s: float = 0.0, sums=None):
         self._obs, self._e, self._dh, self._barrier, self.name = obstacle, e, dhat, barrier, name
+        self._sums = sums
         self.s = s
         self.window = None          # (centre, sample indices) of the last solve's final window
 
     def derivatives(self, pts, kw, s):
         """(B_s, B_ss, feasible, smallest gap (inf for none)) at advance s for flat sample points
         pts (k, 3), weights kw (k,)."""
+        if self._sums is not None:
+            g, gs, dmin = self._sums(pts, kw, s * self._e, self._e, self._dh)
+            return g, gs, dmin > 0, dmin
         d, _, ds, dss = self._obs.along(pts, s * self._e, self._e)
         dmin = float(d.min()) if d.size else np.inf
         if dmin <= 0:

@@ -57,6 +57,16 @@ class Capsule:
                                 np.asarray(self.a, float), np.asarray(self.b, float), float(self.radius),
                                 np.asarray(e, float))
 
+    def log_barrier_sums(self, p: np.ndarray, kw: np.ndarray, shift: np.ndarray, e: np.ndarray, dhat: float):
+        """(B_s, B_ss, smallest gap) of the log barrier of reach dhat over the points p - shift
+        with weights kw, the capsule advancing along e (graspdef.contact.condensation; compiled:
+        graspdef.contact._kernels.capsule_barrier_sums)."""
+        from ._kernels import capsule_barrier_sums
+
+        return capsule_barrier_sums(np.ascontiguousarray(p, dtype=float), np.ascontiguousarray(kw, dtype=float),
+                                    np.asarray(shift, float), np.asarray(self.a, float), np.asarray(self.b, float),
+                                    float(self.radius), np.asarray(e, float), float(dhat))
+
 
 @dataclass(frozen=True)
 class RoundedBox:
@@ -111,3 +121,14 @@ class RoundedBox:
                             np.asarray(self.center, float), np.asarray(self.rotation, float),
                             np.asarray(self.half_extents, float) - self.rounding, float(self.rounding),
                             np.asarray(e, float))
+
+    def log_barrier_sums(self, p: np.ndarray, kw: np.ndarray, shift: np.ndarray, e: np.ndarray, dhat: float):
+        """(B_s, B_ss, smallest gap) of the log barrier of reach dhat over the points p - shift
+        with weights kw, the box advancing along e (graspdef.contact.condensation; compiled:
+        graspdef.contact._kernels.box_barrier_sums)."""
+        from ._kernels import box_barrier_sums
+
+        return box_barrier_sums(np.ascontiguousarray(p, dtype=float), np.ascontiguousarray(kw, dtype=float),
+                                np.asarray(shift, float), np.asarray(self.center, float),
+                                np.asarray(self.rotation, float), np.asarray(self.half_extents, float) - self.rounding,
+                                float(self.rounding), np.asarray(e, float), float(dhat))

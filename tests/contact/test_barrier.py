@@ -91,6 +91,43 @@ def test_obstacle_distance_derivatives(obstacle):
     assert np.allclose(d2, np.einsum("i,kij,j->k", e, H, e), rtol=1e-12, atol=1e-12 * np.abs(H).max())
 
 
+@pytest.mark.parametrize("obstacle", [_pin(), _pad(), RoundedBox((0.0, 0.01, 0.0), tuple(map(tuple, np.linalg.qr(
+    np.random.default_rng(3).normal(size=(3, 3)))[0])), (0.003, 0.005, 0.007), 0.001)], ids=["capsule", "box", "tilted box"])
+def test_the_compiled_barrier_sums_equal_the_numpy_ones(obstacle):
+    """The condensed advance's (B_s, B_ss, feasible, smallest gap) from the obstacle's compiled
+    one-pass sums (``log_barrier_sums``) and from its ``along`` with the barrier summed in numpy
+    (``ForceControlledAdvance.derivatives`` without ``sums``), at points spread through the
+    barrier's reach: the same to round-off (their sums run in other orders); with a point through
+    the obstacle both are infeasible (+inf), with none in reach both are zero."""
+    from graspdef.contact.condensation import ForceControlledAdvance
+
+    rng = np.random.default_rng(5)
+    e = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
+    dh = 4e-4
+    # points outside the surface, moved along their outward normals to gaps in (0.8, 3) dhat: a
+    # shift of the obstacle by |s| <= 0.75 dhat changes a gap by |s| at most (phi is 1-Lipschitz)
+    base = np.asarray(obstacle.a if isinstance(obstacle, Capsule) else obstacle.center) + rng.normal(size=(900, 3)) * 0.006
+    phi, n = obstacle.distance(base, False)
+    base, phi, n = base[phi > 1e-3], phi[phi > 1e-3], n[phi > 1e-3]
+    p = base + n * (rng.uniform(0.8 * dh, 3 * dh, len(base)) - phi)[:, None]
+    kw = rng.uniform(0.5, 2.0, len(p))
+    numpy_way = ForceControlledAdvance(obstacle, e, dh, log_barrier, "numpy")
+    compiled = ForceControlledAdvance(obstacle, e, dh, log_barrier, "compiled", sums=obstacle.log_barrier_sums)
+    for s in (0.0, 0.75 * dh, -0.5 * dh):
+        a, b = numpy_way.derivatives(p, kw, s), compiled.derivatives(p, kw, s)
+        assert a[2] is b[2] is True and a[3] == b[3] > 0
+        assert b[0] == pytest.approx(a[0], rel=1e-12) and b[1] == pytest.approx(a[1], rel=1e-12)
+        assert a[0] != 0 and a[1] > 0                          # points in reach: a real sum
+    inside = p.copy()
+    inside[7] = base[7] - n[7] * (phi[7] + 1e-5)                 # one point 10 um through the surface
+    a, b = numpy_way.derivatives(inside, kw, 0.0), compiled.derivatives(inside, kw, 0.0)
+    assert a[:3] == b[:3] == (np.inf, 0.0, False) and a[3] == b[3] == pytest.approx(-1e-5, rel=1e-6)
+    far = p + 2 * dh * n                                         # every gap beyond the reach
+    a, b = numpy_way.derivatives(far, kw, 0.0), compiled.derivatives(far, kw, 0.0)
+    assert a[:3] == b[:3] == (0.0, 0.0, True) and a[3] == b[3] > dh
+    assert compiled.derivatives(p[:0], kw[:0], 0.0) == numpy_way.derivatives(p[:0], kw[:0], 0.0) == (0.0, 0.0, True, np.inf)
+
+
 @pytest.mark.parametrize("obstacle", [_pin(), _pad()], ids=["pin", "pad"])
 def test_contact_potential_derivatives(shell, obstacle):
     """Value -> gradient -> Hessian (sparse B_xx plus the rank-one -B_xs B_xs^T / B_ss of the
