@@ -223,14 +223,15 @@ class FingerContact(TermBase):
         grad = self._ops.gradient((kw * b1)[:, None] * n, act)          # dB/dp_k scattered
         if order < 2:
             return s, value, grad, None, None, None
-        H = self._obs.distance(P, True)[2]
         ds = -(n @ self._e)
-        He = H @ self._e
+        along = getattr(self._obs, "hessian_along", None)            # H e without the (k, 3, 3) Hessians
+        He = along(P, self._e) if along is not None else self._obs.distance(P, True)[2] @ self._e
         Bss = float((kw * (b2 * ds * ds + b1 * (He @ self._e))).sum())
         vk = (kw * b2 * ds)[:, None] * n - (kw * b1)[:, None] * He     # d2B/dp_k ds
         v = self._ops.gradient(vk, act)
         if order < 3:
             return s, value, grad, None, Bss, v
+        H = self._obs.distance(P, True)[2]
         Hk = (kw * b2)[:, None, None] * n[:, :, None] * n[:, None, :] + (kw * b1)[:, None, None] * H
         return s, value, grad, self._ops.hessian(Hk, act), Bss, v
 

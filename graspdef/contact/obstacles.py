@@ -46,6 +46,24 @@ class Capsule:
             P[side] -= np.outer(u, u)[None]
         return r - self.radius, n, P / r[:, None, None]
 
+    def hessian_along(self, p: np.ndarray, e: np.ndarray) -> np.ndarray:
+        """H e (k, 3): the distance's Hessian at points p (k, 3) outside the capsule times the
+        vector e (3,) -- :meth:`distance`'s Hessian applied to e, without the (k, 3, 3) array."""
+        a, b = np.asarray(self.a, float), np.asarray(self.b, float)
+        e = np.asarray(e, float)
+        ab = b - a
+        L2 = ab @ ab
+        t = np.clip(((p - a) @ ab) / L2, 0.0, 1.0)
+        v = p - (a + t[:, None] * ab)
+        r = np.maximum(np.sqrt(np.einsum("ki,ki->k", v, v)), 1e-300)
+        n = v / r[:, None]
+        He = e[None] - n * (n @ e)[:, None]
+        side = (t > 0) & (t < 1)                                # distance to the axis line
+        if side.any():
+            u = ab / np.sqrt(L2)
+            He[side] -= (u @ e) * u[None]
+        return He / r[:, None]
+
     def along(self, p: np.ndarray, shift: np.ndarray, e: np.ndarray):
         """At the points p - shift (p (k, 3) outside the capsule): phi (k,), the unit normal (k, 3)
         and phi's first two derivatives when the capsule advances by s along the unit vector e (the
@@ -110,6 +128,19 @@ class RoundedBox:
         D = (q > 0).astype(float)
         Hl = (D[:, :, None] * np.eye(3)[None] - nl[:, :, None] * nl[:, None, :]) / r[:, None, None]
         return phi, n, R[None] @ Hl @ R.T[None]
+
+    def hessian_along(self, p: np.ndarray, e: np.ndarray) -> np.ndarray:
+        """H e (k, 3): the distance's Hessian at points p (k, 3) outside the rounded box times the
+        vector e (3,) -- :meth:`distance`'s Hessian applied to e, without the (k, 3, 3) array."""
+        R = np.asarray(self.rotation, float)
+        loc = (p - np.asarray(self.center, float)) @ R
+        q = np.abs(loc) - (np.asarray(self.half_extents, float) - self.rounding)
+        m = np.maximum(q, 0.0)
+        r = np.maximum(np.sqrt(np.einsum("ki,ki->k", m, m)), 1e-300)
+        nl = np.where(loc < 0, -1.0, 1.0) * m / r[:, None]
+        el = np.asarray(e, float) @ R                                  # e in the box's axes
+        Hel = (np.where(q > 0, el[None], 0.0) - nl * (nl @ el)[:, None]) / r[:, None]
+        return Hel @ R.T
 
     def along(self, p: np.ndarray, shift: np.ndarray, e: np.ndarray):
         """At the points p - shift (p (k, 3) outside the box): phi (k,), the unit normal (k, 3) and

@@ -89,6 +89,8 @@ def test_obstacle_distance_derivatives(obstacle):
     assert np.allclose(phi_a, phi, rtol=0, atol=1e-15) and np.allclose(n_a, n, rtol=0, atol=1e-14)
     assert np.allclose(d1, -(n @ e), rtol=1e-14, atol=1e-15)
     assert np.allclose(d2, np.einsum("i,kij,j->k", e, H, e), rtol=1e-12, atol=1e-12 * np.abs(H).max())
+    # the Hessian times e without the (k, 3, 3) array (the condensed advance's B_ss and B_xs)
+    assert np.allclose(obstacle.hessian_along(p - sh, e), H @ e, rtol=1e-13, atol=1e-13 * np.abs(H).max())
 
 
 @pytest.mark.parametrize("obstacle", [_pin(), _pad(), RoundedBox((0.0, 0.01, 0.0), tuple(map(tuple, np.linalg.qr(
