@@ -22,8 +22,8 @@ faster), where numba's fixed cost is small against the solve.
 The ahead-of-time exports release the GIL while they run (as ``njit(nogil=True)`` would: pycc's
 wrappers are built with numba's ``release_gil`` flag), so a term whose work is in such kernels can
 be evaluated in a thread beside the other terms' Python code (graspdef.solve.equilibrium,
-:func:`ahead_of_time`); the pad grasp's shell Hessian, 10 ms of a 28 ms tangent, then overlaps
-the contact terms'.
+:meth:`Kernel.ahead_of_time`); the pad grasp's shell Hessian, 10 ms of a 28 ms tangent, then
+overlaps the contact terms'.
 
 Both builds compute the same numbers: the kernels' parallel loops write disjoint outputs (no
 reductions across iterations) and nothing is compiled with fastmath, so serial and parallel,
