@@ -14,12 +14,15 @@ from ..shell._kernels import sorted_search
 
 
 @kernel()
-def _log_barrier_terms(d, dhat):
-    """b'(d) and b''(d) of the log barrier b(d) = -(d - dh)^2 ln(d / dh), 0 < d < dh
-    (graspdef.contact.barrier.log_barrier: the same formulas)."""
+def _barrier_sums_terms(d, dhat, w, d1, d2):
+    """One point's terms of the condensed advance's sums: w b'(d) d1 and w (b''(d) d1^2 + b'(d) d2)
+    for the log barrier b(d) = -(d - dh)^2 ln(d / dh), 0 < d < dh (graspdef.contact.barrier.log_barrier:
+    the same formulas), d1 = dd/ds and d2 = d2d/ds2."""
     r = d - dhat
     lg = np.log(d / dhat)
-    return -2 * r * lg - r * r / d, -2 * lg - 4 * r / d + r * r / (d * d)
+    b1 = -2 * r * lg - r * r / d
+    b2 = -2 * lg - 4 * r / d + r * r / (d * d)
+    return w * b1 * d1, w * (b2 * d1 * d1 + b1 * d2)
 
 
 @kernel()
@@ -61,19 +64,18 @@ def _box_scan(P, shift, c, R, h, rounding, e, kw, dhat, phi, n, d1, d2):
             r = 1e-300
         ne = (sm[0] * el[0] + sm[1] * el[1] + sm[2] * el[2]) / r
         d = (qmax if inside else r) - rounding
+        dd = (dee - ne * ne) / r
         if fill:
             phi[i] = d
             for a in range(3):
                 n[i, a] = (R[a, 0] * sm[0] + R[a, 1] * sm[1] + R[a, 2] * sm[2]) / r
             d1[i] = -ne
-            d2[i] = (dee - ne * ne) / r
+            d2[i] = dd
         if add:
-            if d < dmin:
-                dmin = d
+            dmin = min(dmin, d)
             if d > 0.0 and d < dhat:
-                b1, b2 = _log_barrier_terms(d, dhat)
-                gs -= kw[i] * b1 * ne
-                gss += kw[i] * (b2 * ne * ne + b1 * (dee - ne * ne) / r)
+                g1, g2 = _barrier_sums_terms(d, dhat, kw[i], -ne, dd)
+                gs, gss = gs + g1, gss + g2
     return gs, gss, dmin
 
 
@@ -141,12 +143,10 @@ def _capsule_scan(P, shift, a, b, radius, e, kw, dhat, phi, n, d1, d2):
             d1[i] = -ne
             d2[i] = dd
         if add:
-            if d < dmin:
-                dmin = d
+            dmin = min(dmin, d)
             if d > 0.0 and d < dhat:
-                b1, b2 = _log_barrier_terms(d, dhat)
-                gs -= kw[i] * b1 * ne
-                gss += kw[i] * (b2 * ne * ne + b1 * dd)
+                g1, g2 = _barrier_sums_terms(d, dhat, kw[i], -ne, dd)
+                gs, gss = gs + g1, gss + g2
     return gs, gss, dmin
 
 

@@ -27,40 +27,36 @@ class Capsule:
         """Lateral extent about the closing axis [m]."""
         return self.radius
 
-    def distance(self, p: np.ndarray, hessian: bool = True):
-        """phi (k,), grad (k, 3) and (``hessian``) Hessian (k, 3, 3) of the distance to the
-        capsule surface at points p (k, 3) outside it."""
+    def _nearest(self, p: np.ndarray):
+        """For points p (k, 3): the distance r (k,) to the axis segment (>= 1e-300), the unit
+        normal n (k, 3), whether the nearest axis point is inside the segment (k,), and the
+        segment's unit direction u (3,)."""
         a, b = np.asarray(self.a, float), np.asarray(self.b, float)
         ab = b - a
         L2 = ab @ ab
         t = np.clip(((p - a) @ ab) / L2, 0.0, 1.0)
         v = p - (a + t[:, None] * ab)
         r = np.maximum(np.sqrt(np.einsum("ki,ki->k", v, v)), 1e-300)
-        n = v / r[:, None]
+        return r, v / r[:, None], (t > 0) & (t < 1), ab / np.sqrt(L2)
+
+    def distance(self, p: np.ndarray, hessian: bool = True):
+        """phi (k,), grad (k, 3) and (``hessian``) Hessian (k, 3, 3) of the distance to the
+        capsule surface at points p (k, 3) outside it."""
+        r, n, side, u = self._nearest(p)
         if not hessian:
             return r - self.radius, n
         P = np.eye(3)[None] - n[:, :, None] * n[:, None, :]
-        side = (t > 0) & (t < 1)                                # distance to the axis line
-        if side.any():
-            u = ab / np.sqrt(L2)
+        if side.any():                                          # distance to the axis line
             P[side] -= np.outer(u, u)[None]
         return r - self.radius, n, P / r[:, None, None]
 
     def hessian_along(self, p: np.ndarray, e: np.ndarray) -> np.ndarray:
         """H e (k, 3): the distance's Hessian at points p (k, 3) outside the capsule times the
         vector e (3,) -- :meth:`distance`'s Hessian applied to e, without the (k, 3, 3) array."""
-        a, b = np.asarray(self.a, float), np.asarray(self.b, float)
+        r, n, side, u = self._nearest(p)
         e = np.asarray(e, float)
-        ab = b - a
-        L2 = ab @ ab
-        t = np.clip(((p - a) @ ab) / L2, 0.0, 1.0)
-        v = p - (a + t[:, None] * ab)
-        r = np.maximum(np.sqrt(np.einsum("ki,ki->k", v, v)), 1e-300)
-        n = v / r[:, None]
         He = e[None] - n * (n @ e)[:, None]
-        side = (t > 0) & (t < 1)                                # distance to the axis line
-        if side.any():
-            u = ab / np.sqrt(L2)
+        if side.any():                                          # distance to the axis line
             He[side] -= (u @ e) * u[None]
         return He / r[:, None]
 
@@ -107,20 +103,24 @@ class RoundedBox:
         h = np.sort(np.asarray(self.half_extents, float))
         return float(np.hypot(h[1], h[2]))
 
+    def _nearest(self, p: np.ndarray):
+        """For points p (k, 3), in the box's axes: the excess q (k, 3) of |coordinates| over the
+        inner box, the distance r (k,) to the inner box (0 inside), and the unit normal nl (k, 3)
+        (with r >= 1e-300 in its division)."""
+        R = np.asarray(self.rotation, float)
+        loc = (p - np.asarray(self.center, float)) @ R
+        q = np.abs(loc) - (np.asarray(self.half_extents, float) - self.rounding)   # inner box
+        m = np.maximum(q, 0.0)
+        r = np.sqrt(np.einsum("ki,ki->k", m, m))
+        return q, r, np.where(loc < 0, -1.0, 1.0) * m / np.maximum(r, 1e-300)[:, None]
+
     def distance(self, p: np.ndarray, hessian: bool = True):
         """phi (k,), grad (k, 3) and (``hessian``) Hessian (k, 3, 3) of the distance to the
         rounded box's surface at points p (k, 3) outside it."""
         R = np.asarray(self.rotation, float)
-        c = np.asarray(self.center, float)
-        h = np.asarray(self.half_extents, float) - self.rounding        # inner box
-        loc = (p - c) @ R
-        s = np.where(loc < 0, -1.0, 1.0)
-        q = np.abs(loc) - h
-        m = np.maximum(q, 0.0)
-        r = np.sqrt(np.einsum("ki,ki->k", m, m))
+        q, r, nl = self._nearest(p)
         inside = r <= 0
         r = np.maximum(r, 1e-300)
-        nl = s * m / r[:, None]
         phi = np.where(inside, q.max(axis=1), r) - self.rounding
         n = nl @ R.T
         if not hessian:
@@ -133,13 +133,9 @@ class RoundedBox:
         """H e (k, 3): the distance's Hessian at points p (k, 3) outside the rounded box times the
         vector e (3,) -- :meth:`distance`'s Hessian applied to e, without the (k, 3, 3) array."""
         R = np.asarray(self.rotation, float)
-        loc = (p - np.asarray(self.center, float)) @ R
-        q = np.abs(loc) - (np.asarray(self.half_extents, float) - self.rounding)
-        m = np.maximum(q, 0.0)
-        r = np.maximum(np.sqrt(np.einsum("ki,ki->k", m, m)), 1e-300)
-        nl = np.where(loc < 0, -1.0, 1.0) * m / r[:, None]
+        q, r, nl = self._nearest(p)
         el = np.asarray(e, float) @ R                                  # e in the box's axes
-        Hel = (np.where(q > 0, el[None], 0.0) - nl * (nl @ el)[:, None]) / r[:, None]
+        Hel = (np.where(q > 0, el[None], 0.0) - nl * (nl @ el)[:, None]) / np.maximum(r, 1e-300)[:, None]
         return Hel @ R.T
 
     def along(self, p: np.ndarray, shift: np.ndarray, e: np.ndarray):
