@@ -409,7 +409,7 @@ def run_nonlinear_benchmarks(folder: Path, pattern: str = "*",
 def kernel_workout(progress: Callable[[str], None] = lambda m: None) -> None:
     """Small solves that call every compiled kernel with an ahead-of-time export: the Tian & Jia
     plate (linear: patterns, strains, the shell's assembly, the KKT matrix), a neo-Hookean ball
-    holding gas between two point loads (densities, enclosed volume), two pads with friction and
+    holding gas between two point loads (densities, enclosed volume, the tangent's products), two pads with friction and
     two pins squeezing a sphere (box and capsule distances, the contact samples' gather, scatter
     and Hessian)."""
     from .contact.barrier import Capsule, FingerContact, RoundedBox
@@ -432,8 +432,17 @@ def kernel_workout(progress: Callable[[str], None] = lambda m: None) -> None:
     pr = Problem(Shell(m.vertices, m.faces, NeoHookean(1e6 / 3), t), [EnclosedGas(8e4)], [RigidModes()])
     top, bot = pr.locate((0, 0, R)), pr.locate((0, 0, -R))
     pr.loads += [PointLoad(top.face, top.bary, (0, 0, -2.0)), PointLoad(bot.face, bot.bary, (0, 0, 2.0))]
-    if not solve_nonlinear(pr, PathOptions(steps=2)).completed:
+    sol = solve_nonlinear(pr, PathOptions(steps=2))
+    if not sol.completed:
         raise RuntimeError("kernel workout: the ball's path stopped")
+    # the tangent's products (csr_products): below SERIAL_MAX scipy multiplies, so the kernel is
+    # called here on the ball's tangent at its last point and two columns of its displacement
+    from .solve._kernels import csr_products
+    from .solve.equilibrium import Equilibrium
+
+    H = Equilibrium(pr).evaluate(sol.u.ravel(), sol.load_factor).hessian.tocsr()
+    X = np.ascontiguousarray(np.column_stack([sol.u.ravel(), np.roll(sol.u.ravel(), 1)]))
+    csr_products(H.indptr, H.indices, np.ascontiguousarray(H.data), X, np.empty((H.shape[0], 2)))
     shell = Shell(m.vertices, m.faces, LinearElastic(1e6, 0.45), 0.002)
     h = 0.001                                            # half the wall
 

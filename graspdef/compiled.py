@@ -44,6 +44,7 @@ import importlib
 import json
 import logging
 import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -69,6 +70,7 @@ prange = range
 _REGISTRY: dict[str, list["Kernel"]] = {}      # module name -> its kernels, in definition order
 _aot_state: dict = {}                          # "module": the loaded ahead-of-time module or None
 _recorder: dict | None = None                  # inside recording(): export name -> (kernel, export, args)
+_JIT_LOCK = threading.RLock()                  # making a module's JIT build (from any thread)
 
 
 class Kernel:
@@ -85,6 +87,7 @@ class Kernel:
         self.__module__ = fn.__module__
         self._jit = None                 # numba dispatcher, once the JIT build is made
         self._aot: list | None = None    # the ahead-of-time exports (empty: none usable)
+        self._ready: set = set()         # argument-type keys whose JIT overload is loaded (_Loader)
         _REGISTRY.setdefault(fn.__module__, []).append(self)
 
     def __repr__(self):
@@ -98,11 +101,27 @@ class Kernel:
             self._aot = _aot_exports(self)
         if _recorder is not None:
             _record(self, args)
-        if self._aot and self.serial(args[self.work].shape[0]):
-            for f, spec in self._aot:
-                if _matches(args, spec):
-                    return f(*args)
+        if self._aot:
+            if self.serial(args[self.work].shape[0]):
+                for f, spec in self._aot:
+                    if _matches(args, spec):
+                        return f(*args)
+            elif not self._jit_ready(args):      # the JIT build is being loaded beside this call
+                for f, spec in self._aot:
+                    if _matches(args, spec):
+                        return f(*args)
         return self.jit(*args)
+
+    def _jit_ready(self, args) -> bool:
+        """Whether the JIT build's overload for these argument types is loaded; if not, asks the
+        loader thread for it (:class:`_Loader`) and returns False -- the call then runs ahead of
+        time, serially, while numba is imported and the overload loaded on the other core.  Types
+        the loader cannot name (tuples, None, ...) are loaded by the call itself (True)."""
+        key = _type_key(args)
+        if key is None or key in self._ready:
+            return True
+        _LOADER.request(self, key)
+        return key in self._ready
 
     def serial(self, work: int) -> bool:
         """Whether a call with this much work (``args[work].shape[0]``) runs serially ahead of time
@@ -122,8 +141,120 @@ class Kernel:
     def jit(self):
         """The JIT build (numba dispatcher); compiles the whole module's kernels on first use."""
         if self._jit is None:
-            _jit_module(self.__module__)
+            with _JIT_LOCK:
+                if self._jit is None:
+                    _jit_module(self.__module__)
         return self._jit
+
+
+def _type_key(args) -> tuple | None:
+    """A hashable key of the numba types of a call's arguments, made without numba (as
+    ``numba.typeof`` types them: an array by dtype, dimensions, layout -- C, F or A --, writeable
+    and aligned flags; a scalar by its numpy dtype, a Python int as int64 and a float as float64);
+    None where an argument is of another kind."""
+    key = []
+    for a in args:
+        if isinstance(a, np.ndarray):
+            fl = a.flags
+            key.append((a.dtype, a.ndim, "C" if fl.c_contiguous else ("F" if fl.f_contiguous else "A"),
+                        bool(fl.writeable), bool(fl.aligned)))
+        elif isinstance(a, (bool, int, float, np.bool_, np.integer, np.floating)):
+            key.append(np.dtype(type(a)))
+        else:
+            return None
+    return tuple(key)
+
+
+def _numba_types(key: tuple) -> tuple:
+    """The numba argument types of a :func:`_type_key` (in the loader thread: imports numba)."""
+    import numba
+    from numba.core import types
+
+    return tuple(types.Array(numba.from_dtype(k[0]), k[1], k[2], readonly=not k[3], aligned=k[4])
+                 if isinstance(k, tuple) else numba.from_dtype(k) for k in key)
+
+
+def _key_of(sig) -> tuple:
+    """The :func:`_type_key` of a numba signature's argument types."""
+    from numba.core import types
+
+    return tuple((np.dtype(str(t.dtype)), t.ndim, t.layout, t.mutable, t.aligned)
+                 if isinstance(t, types.Array) else np.dtype(str(t)) for t in sig.args)
+
+
+class _Loader:
+    """Loads JIT overloads in a thread of its own while the calls that need them run ahead of time
+    (:meth:`Kernel._jit_ready`, :func:`prepare`).
+
+    A large problem's first kernel calls used to wait for numba: its import and the loading of each
+    kernel's overload from the on-disk cache (~0.6 s on the 10k ball, on one thread, inside the
+    path).  The two builds give the same numbers to the bit (the module docstring), so a call may
+    take either: until its overload is loaded it runs the serial ahead-of-time export (which
+    releases the GIL) and numba works on the other core -- beside the shell's set-up
+    (:func:`prepare`) and PARDISO's analysis, which run on one thread.  The thread ends when nothing
+    is asked and is started again when something is.  A load that fails marks its key loaded: the
+    next call then compiles it itself and raises numba's own error, if any."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._queue: list = []
+        self._asked: set = set()
+        self._thread: threading.Thread | None = None
+
+    def request(self, k: Kernel, key: tuple | None = None, signature: str | None = None) -> None:
+        """Load ``k``'s overload for a :func:`_type_key` or for a signature string."""
+        with self._lock:
+            if (id(k), key, signature) in self._asked:
+                return
+            self._asked.add((id(k), key, signature))
+            self._queue.append((k, key, signature))
+            if self._thread is None:
+                self._thread = threading.Thread(target=self._run, name="graspdef-jit-loader", daemon=True)
+                self._thread.start()
+
+    def _run(self) -> None:
+        while True:
+            with self._lock:
+                if not self._queue:
+                    self._thread = None
+                    return
+                k, key, signature = self._queue.pop(0)
+            try:
+                if signature is not None:
+                    sig = _signature(signature)
+                    k.jit.compile(sig.args)
+                    key = _key_of(sig)
+                else:
+                    k.jit.compile(_numba_types(key))
+            except Exception as e:              # the call's own compilation reports it
+                log.debug("loading %s's JIT build for %s failed: %s", k.__name__, key or signature, e)
+            if key is not None:
+                k._ready.add(key)
+
+    def join(self) -> None:
+        """Wait until everything asked so far is loaded."""
+        while True:
+            t = self._thread
+            if t is None:
+                return
+            t.join()
+
+
+def prepare(n_faces: int) -> None:
+    """Start loading the JIT build of every parallel kernel that a shell of ``n_faces`` faces runs
+    there (work above :data:`SERIAL_MAX`), for its ahead-of-time signatures' types, in the loader
+    thread (:class:`_Loader`): numba's import and the cached overloads then load beside the shell's
+    set-up instead of inside its first solve.  Nothing to do for a small shell, or without the
+    ahead-of-time module (the calls then wait for the JIT build anyway)."""
+    if _aot_module() is None:
+        return
+    for k in kernels():
+        if k.parallel and k.signatures and not k.serial(int(k.per_face * n_faces)):
+            for text in k.signatures:
+                _LOADER.request(k, signature=text)
+
+
+_LOADER = _Loader()
 
 
 def kernel(*, parallel: bool = False, aot: tuple[str, ...] | list[str] = (), work: int = 0,

@@ -147,3 +147,109 @@ def test_bench_kernels_writes_its_folder_and_refuses_options_it_ignores(tmp_path
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and extra[0] in err[0], err
         assert not (tmp_path / "x").exists()
+
+
+@pytest.fixture
+def fresh_loader(monkeypatch):
+    """A loader of its own and no overload marked loaded, for the test (restored after it)."""
+    compiled.kernels()
+    monkeypatch.setattr(compiled, "_LOADER", compiled._Loader())
+    for ks in compiled._REGISTRY.values():
+        for k in ks:
+            monkeypatch.setattr(k, "_ready", set())
+    return compiled._LOADER
+
+
+def _ball_shell(subdivisions=2):
+    from graspdef.geometry import icosphere
+    from graspdef.shell.hyperelastic import NeoHookean
+    from graspdef.shell.model import Shell
+
+    m = icosphere(radius=0.0325, subdivisions=subdivisions)
+    return Shell(m.vertices, m.faces, NeoHookean(1e6 / 3), 0.0025)
+
+
+def test_a_large_call_runs_ahead_of_time_until_its_jit_build_is_loaded(monkeypatch, fresh_loader):
+    """compiled._Loader: a call above SERIAL_MAX whose JIT overload is not loaded runs the serial
+    ahead-of-time export and asks the loader thread for it; once loaded, the same call runs the JIT
+    build -- the overload the loader made (no other is compiled for the call) -- with the same
+    numbers to the bit.  The loader's thread ends when nothing is asked."""
+    from graspdef.shell._kernels import block_positions
+
+    shell = _ball_shell()
+    pat = shell.block_pattern
+    st = np.ascontiguousarray(shell.basis.groups[0].stencils, np.int64)
+    args = (st, pat.indptr, pat.cols)
+    monkeypatch.setattr(compiled, "SERIAL_MAX", 1)            # every call of this shell "large"
+    export, spec = block_positions._aot[0] if block_positions._aot else compiled._aot_exports(block_positions)[0]
+    calls = []
+    monkeypatch.setattr(block_positions, "_aot", [(lambda *a: calls.append(1) or export(*a), spec)])
+    first = block_positions(*args)
+    assert calls == [1]                                       # ran ahead of time, and asked
+    fresh_loader.join()
+    assert fresh_loader._thread is None
+    key = compiled._type_key(args)
+    assert key in block_positions._ready
+    n = len(block_positions.jit.overloads)
+    again = block_positions(*args)
+    assert calls == [1] and len(block_positions.jit.overloads) == n    # the JIT build, already loaded
+    assert np.array_equal(first, again)
+
+
+def test_a_large_shell_loads_its_kernels_jit_build_beside_its_set_up(monkeypatch, fresh_loader):
+    """compiled.prepare (called by Shell): for a shell above SERIAL_MAX every parallel kernel's
+    overload for its ahead-of-time signatures is loaded in the loader thread, and the shell's own
+    calls (an energy Hessian, the enclosed volume) have exactly those types: they run the JIT build
+    without compiling anything more.  A small shell asks for nothing."""
+    from graspdef.problem.potentials import EnclosedGas
+    from graspdef.problem.problem import Problem
+    from graspdef.problem.supports import RigidModes
+    from graspdef.solve.equilibrium import Equilibrium
+
+    small = _ball_shell(1)
+    assert not fresh_loader._asked
+    monkeypatch.setattr(compiled, "SERIAL_MAX", 16)
+    shell = _ball_shell(2)                                    # 320 faces
+    asked = {k.__name__ for k, _, _ in fresh_loader._queue} | {k.__name__ for k in compiled.kernels()
+                                                               if any(a[0] == id(k) for a in fresh_loader._asked)}
+    assert {"assemble_elements", "point_strains", "density_points", "_volume_terms", "row_sums",
+            "csr_products"} <= asked
+    fresh_loader.join()
+    par = [k for k in compiled.kernels() if k.parallel and k.signatures]
+    before = {k.__name__: len(k.jit.overloads) for k in par}
+    aot_calls = []
+    for k in par:
+        monkeypatch.setattr(k, "_aot", [(lambda *a, f=f, k=k: aot_calls.append((k.__name__, compiled._type_key(a), sorted(k._ready, key=str))) or f(*a), s) for f, s in compiled._aot_exports(k)])
+    eq = Equilibrium(Problem(shell, [EnclosedGas(8e4)], [RigidModes()]))
+    st = eq.evaluate(np.zeros(eq.n), 0.0, 2)
+    assert st.hessian is not None and np.isfinite(st.energy)
+    assert aot_calls == [], "\n".join(map(repr, aot_calls))
+    assert {k.__name__: len(k.jit.overloads) for k in par} == before
+    assert small.n_control < shell.n_control
+
+
+def test_the_loaders_builds_give_a_path_to_the_bit(monkeypatch, fresh_loader):
+    """A nonlinear path whose first calls ran ahead of time while the JIT build loaded equals, to
+    the bit, the same path with every large call on the JIT build from the start (the module
+    docstring: the two builds compute the same numbers)."""
+    from graspdef.problem.loads import PointLoad
+    from graspdef.problem.potentials import EnclosedGas
+    from graspdef.problem.problem import Problem
+    from graspdef.problem.supports import RigidModes
+    from graspdef.solve.nonlinear import PathOptions, solve_nonlinear
+
+    monkeypatch.setattr(compiled, "SERIAL_MAX", 16)
+
+    def path():
+        shell = _ball_shell(2)
+        pr = Problem(shell, [EnclosedGas(8e4)], [RigidModes()])
+        top, bot = pr.locate((0, 0, 0.0325)), pr.locate((0, 0, -0.0325))
+        pr.loads += [PointLoad(top.face, top.bary, (0, 0, -2.0)), PointLoad(bot.face, bot.bary, (0, 0, 2.0))]
+        sol = solve_nonlinear(pr, PathOptions(steps=2))
+        assert sol.completed
+        return sol.u, [p.load_factor for p in sol.path]
+
+    first = path()                      # the loader works beside it (what it loads depends on timing)
+    fresh_loader.join()
+    second = path()                     # everything loaded: every large call on the JIT build
+    assert np.array_equal(first[0], second[0]) and first[1] == second[1]

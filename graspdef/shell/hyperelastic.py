@@ -240,10 +240,13 @@ class _ThicknessIntegrated:
         t = np.asarray(thickness, dtype=float)
         shape = np.broadcast_shapes(s.shape[:-1], rest_inv.shape[:-1], t.shape)
         n = math.prod(shape)
-        sf = np.ascontiguousarray(np.broadcast_to(s, shape + (6,)).reshape(n, 6))
-        rf = np.ascontiguousarray(np.broadcast_to(rest_inv, shape + (3,)).reshape(n, 3))
+        # (an array already of the points' shape is reshaped, not broadcast: numba types a
+        # broadcast's read-only view apart, graspdef.compiled._Loader)
+        sf = np.ascontiguousarray(s.reshape(n, 6) if s.shape[:-1] == shape else np.broadcast_to(s, shape + (6,)).reshape(n, 6))
+        rf = np.ascontiguousarray(rest_inv.reshape(n, 3) if rest_inv.shape[:-1] == shape
+                                  else np.broadcast_to(rest_inv, shape + (3,)).reshape(n, 3))
         half = 0.5 * np.broadcast_to(t, shape).reshape(n)
-        xg, wg = _gauss(self.n_thickness)
+        xg, wg = (a.copy() for a in _gauss(self.n_thickness))       # writable, as reshaped above
         W, dW, ddW, conv = density_points(kind[0], np.asarray(kind[1], dtype=float), sf, rf, half,
                                           xg, wg, order, 8.0 * _EPS, _NEWTON_MAX)
         if not conv.all():

@@ -141,7 +141,8 @@ def row_sums(indptr, indices, a, b, out, x2, abs_sums, sq_sums, diag):
         abs_sums[i] = abs(v[lo]) + r
 
 
-@kernel(parallel=True, work=4, per_face=1.5)      # rows; JIT only: below its SERIAL_MAX scipy multiplies
+@kernel(parallel=True, work=4, per_face=1.5,      # rows; below its SERIAL_MAX scipy multiplies
+        aot=("void(i4[::1], i4[::1], f8[::1], f8[:,::1], f8[:,::1])",))    # while the JIT loads (compiled._Loader)
 def csr_products(indptr, indices, data, X, Y):
     """Y = A X for a CSR matrix A and a block X (n, k) of k columns, rows in parallel: each entry
     Y[i, j] is summed over row i in index order from 0 -- scipy's ``csr_matvec`` per column, to the
