@@ -21,7 +21,7 @@ import sys
 import time
 from pathlib import Path
 
-from _trees import code_trees       # scripts/_trees.py: the working tree and --ref's worktree
+from _trees import code_trees, tree_env       # scripts/_trees.py: the working tree and --ref's worktree
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -41,7 +41,7 @@ print(json.dumps({"timings": r["timings_s"], "indentation_mm": r["feedback"]["in
 def _run(k: int, tree: Path, a) -> dict:
     """One fresh process of the grasp in ``tree`` (its graspdef on PYTHONPATH)."""
     t0 = time.perf_counter()
-    env = dict(os.environ, PYTHONPATH=str(tree))
+    env = tree_env(tree)          # the tree's own runtime.configure() (scripts/_trees.py)
     env.setdefault("GRASPDEF_SHARED_SCANS", str(ROOT.parent / "shared" / "scans"))   # the OLD tree's ../shared is not there
     res = subprocess.run([sys.executable, "-c", CHILD, f"out/bench_grasp_run{k}", a.contact, a.scene], capture_output=True,
                          text=True, cwd=tree, env=env)

@@ -30,7 +30,7 @@ import sys
 import time
 from pathlib import Path
 
-from _trees import code_trees       # scripts/_trees.py: the working tree and --ref's worktree
+from _trees import code_trees, tree_env       # scripts/_trees.py: the working tree and --ref's worktree
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -92,7 +92,7 @@ print(json.dumps({"n_control": int(shell.mesh.n_real), "import_s": t_imp - t0, "
 
 def _run(a, tree: Path) -> dict:
     t0 = time.perf_counter()
-    env = {**os.environ, "PYTHONPATH": str(tree)}
+    env = tree_env(tree)          # the tree's own runtime.configure() (scripts/_trees.py)
     res = subprocess.run([sys.executable, "-c", CHILD, str(a.subdivisions), str(a.steps), str(a.force), str(a.gas_kpa),
                           "1" if a.fixed_steps else "0", str(a.krylov)] + ([a.predictor] if a.predictor else []),
                          cwd=tree, env=env,

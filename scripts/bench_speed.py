@@ -38,7 +38,7 @@ import sys
 import time
 from pathlib import Path
 
-from _trees import code_trees       # scripts/_trees.py: the working tree and --ref's worktree
+from _trees import code_trees, tree_env       # scripts/_trees.py: the working tree and --ref's worktree
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -83,7 +83,7 @@ print(json.dumps({"runs": runs, "peak_MB": peak}))
 def _child(n_z: int, repeats: int, tree: Path, backend: str = "auto", ncol: int = 2) -> dict:
     """One fresh process of ``tree``'s code: ``repeats`` timed solves after a warm-up (out of core:
     ``repeats`` processes of one timed solve each, merged)."""
-    env = {**os.environ, "PYTHONPATH": str(tree)}
+    env = tree_env(tree)          # the tree's own runtime.configure() (scripts/_trees.py)
     results = []
     for _ in range(repeats if backend == "pardiso-ooc" else 1):
         out = subprocess.run([sys.executable, "-c", CHILD, str(n_z), str(repeats), str(tree / "scripts"), backend, str(ncol)],
