@@ -61,6 +61,12 @@ KERNEL_MODULES = ("graspdef.shell._kernels", "graspdef.shell.volume", "graspdef.
 #: 5,120 faces (a nonlinear path of ~50 Hessians; 7,686 rows) keep both cores
 SERIAL_MAX = 4096
 
+#: while a parallel kernel's JIT overload is being loaded (:class:`_Loader`), a call with at most
+#: this much work (as :data:`SERIAL_MAX`) runs the serial ahead-of-time export instead of waiting
+#: for it; a larger one waits.  A serial run must not cost more than the load it saves (~0.5 s):
+#: the 10k ball's shell Hessian (20,480 faces) takes 158 ms serially and 81 ms on both cores
+LOADING_MAX = 8 * SERIAL_MAX
+
 AOT_NAME = "_aot"                              # graspdef/_aot*.so and graspdef/_aot.json
 _HERE = Path(__file__).resolve().parent
 
@@ -102,12 +108,9 @@ class Kernel:
         if _recorder is not None:
             _record(self, args)
         if self._aot:
-            if self.serial(args[self.work].shape[0]):
-                for f, spec in self._aot:
-                    if _matches(args, spec):
-                        return f(*args)
-            elif not self._jit_ready(args):      # the JIT build is being loaded beside this call
-                for f, spec in self._aot:
+            work = args[self.work].shape[0]
+            if self.serial(work) or (work <= self.per_face * LOADING_MAX and not self._jit_ready(args)):
+                for f, spec in self._aot:        # (the second case: the JIT build loads beside it)
                     if _matches(args, spec):
                         return f(*args)
         return self.jit(*args)
@@ -189,10 +192,13 @@ class _Loader:
     A large problem's first kernel calls used to wait for numba: its import and the loading of each
     kernel's overload from the on-disk cache (~0.6 s on the 10k ball, on one thread, inside the
     path).  The two builds give the same numbers to the bit (the module docstring), so a call may
-    take either: until its overload is loaded it runs the serial ahead-of-time export (which
-    releases the GIL) and numba works on the other core -- beside the shell's set-up
-    (:func:`prepare`) and PARDISO's analysis, which run on one thread.  The thread ends when nothing
-    is asked and is started again when something is.  A load that fails marks its key loaded: the
+    take either: until its overload is loaded a call of at most :data:`LOADING_MAX` work runs the
+    serial ahead-of-time export (which releases the GIL) and numba works on the other core -- beside
+    the first evaluations and PARDISO's analysis of the first tangent, which runs on one thread.
+    Started at the path's start (:func:`prepare`, all of a shell's kernels at once) it cost the 10k
+    ball's whole process 0.15 s less than started at the shell's creation, where the loader's Python
+    shared the GIL with the set-up's (5 alternating runs each, 2026-12-07).  The thread ends when
+    nothing is asked and is started again when something is.  A load that fails marks its key loaded: the
     next call then compiles it itself and raises numba's own error, if any."""
 
     def __init__(self):
@@ -243,9 +249,10 @@ class _Loader:
 def prepare(n_faces: int) -> None:
     """Start loading the JIT build of every parallel kernel that a shell of ``n_faces`` faces runs
     there (work above :data:`SERIAL_MAX`), for its ahead-of-time signatures' types, in the loader
-    thread (:class:`_Loader`): numba's import and the cached overloads then load beside the shell's
-    set-up instead of inside its first solve.  Nothing to do for a small shell, or without the
-    ahead-of-time module (the calls then wait for the JIT build anyway)."""
+    thread (:class:`_Loader`), all at once: numba's import and the cached overloads then load while
+    the first evaluations run ahead of time and PARDISO analyses the first tangent on one thread
+    (graspdef.solve.equilibrium.Equilibrium calls it).  Nothing to do for a small shell, or without
+    the ahead-of-time module (the calls then wait for the JIT build anyway)."""
     if _aot_module() is None:
         return
     for k in kernels():

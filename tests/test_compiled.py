@@ -196,20 +196,24 @@ def test_a_large_call_runs_ahead_of_time_until_its_jit_build_is_loaded(monkeypat
     assert np.array_equal(first, again)
 
 
-def test_a_large_shell_loads_its_kernels_jit_build_beside_its_set_up(monkeypatch, fresh_loader):
-    """compiled.prepare (called by Shell): for a shell above SERIAL_MAX every parallel kernel's
-    overload for its ahead-of-time signatures is loaded in the loader thread, and the shell's own
-    calls (an energy Hessian, the enclosed volume) have exactly those types: they run the JIT build
-    without compiling anything more.  A small shell asks for nothing."""
+def test_a_large_shells_solve_loads_its_kernels_jit_build_at_its_start(monkeypatch, fresh_loader):
+    """compiled.prepare (called by Equilibrium): for a shell above SERIAL_MAX every parallel
+    kernel's overload for its ahead-of-time signatures is loaded in the loader thread, and the
+    solve's own calls (the shell's Hessian, the enclosed volume, the tangent's sum) have exactly
+    those types: they run the JIT build without compiling anything more.  A small shell asks for
+    nothing."""
     from graspdef.problem.potentials import EnclosedGas
     from graspdef.problem.problem import Problem
     from graspdef.problem.supports import RigidModes
     from graspdef.solve.equilibrium import Equilibrium
 
     small = _ball_shell(1)
+    Equilibrium(Problem(small, [EnclosedGas(8e4)], [RigidModes()]))
     assert not fresh_loader._asked
     monkeypatch.setattr(compiled, "SERIAL_MAX", 16)
     shell = _ball_shell(2)                                    # 320 faces
+    assert not fresh_loader._asked                            # asked when its solve starts
+    eq = Equilibrium(Problem(shell, [EnclosedGas(8e4)], [RigidModes()]))
     asked = {k.__name__ for k, _, _ in fresh_loader._queue} | {k.__name__ for k in compiled.kernels()
                                                                if any(a[0] == id(k) for a in fresh_loader._asked)}
     assert {"assemble_elements", "point_strains", "density_points", "_volume_terms", "row_sums",
@@ -220,7 +224,6 @@ def test_a_large_shell_loads_its_kernels_jit_build_beside_its_set_up(monkeypatch
     aot_calls = []
     for k in par:
         monkeypatch.setattr(k, "_aot", [(lambda *a, f=f, k=k: aot_calls.append((k.__name__, compiled._type_key(a), sorted(k._ready, key=str))) or f(*a), s) for f, s in compiled._aot_exports(k)])
-    eq = Equilibrium(Problem(shell, [EnclosedGas(8e4)], [RigidModes()]))
     st = eq.evaluate(np.zeros(eq.n), 0.0, 2)
     assert st.hessian is not None and np.isfinite(st.energy)
     assert aot_calls == [], "\n".join(map(repr, aot_calls))
@@ -253,3 +256,21 @@ def test_the_loaders_builds_give_a_path_to_the_bit(monkeypatch, fresh_loader):
     fresh_loader.join()
     second = path()                     # everything loaded: every large call on the JIT build
     assert np.array_equal(first[0], second[0]) and first[1] == second[1]
+
+
+def test_a_call_above_loading_max_waits_for_its_jit_build(monkeypatch, fresh_loader):
+    """A call with more work than LOADING_MAX is not run serially while its overload loads (a
+    long serial run would cost more than the load): it runs the JIT build, loading it itself."""
+    from graspdef.shell._kernels import block_positions
+
+    shell = _ball_shell()
+    pat = shell.block_pattern
+    args = (np.ascontiguousarray(shell.basis.groups[0].stencils, np.int64), pat.indptr, pat.cols)
+    monkeypatch.setattr(compiled, "SERIAL_MAX", 1)
+    monkeypatch.setattr(compiled, "LOADING_MAX", 1)
+    export, spec = compiled._aot_exports(block_positions)[0]
+    calls = []
+    monkeypatch.setattr(block_positions, "_aot", [(lambda *a: calls.append(1) or export(*a), spec)])
+    out = block_positions(*args)
+    assert calls == [] and not fresh_loader._asked
+    assert np.array_equal(out, export(*args))

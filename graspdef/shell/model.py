@@ -7,7 +7,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import compiled
 from ..errors import ProblemError
 from ..subdivision.basis import LoopBasis, build_basis
 from ..subdivision.evaluate import SurfaceEvaluator
@@ -78,7 +77,6 @@ class Shell:
         if self.n_quad not in (3, 6, 12):
             raise ProblemError(f"n_quad must be 3, 6 or 12 Gauss points per face, got {self.n_quad} "
                                "(one point leaves spurious zero-energy modes)")
-        compiled.prepare(len(self.faces))      # a large shell's JIT kernels load beside its set-up
         mesh = add_ghost_layer(self.vertices, self.faces)
         if self.interpolate or (self.interpolate is None and len(mesh.boundary_edges) == 0):
             mesh = mesh.interpolating()

@@ -43,6 +43,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .. import compiled
 from ..errors import SolverError
 from ..problem.problem import Problem
 from ..problem.terms import EnergyTerm
@@ -156,6 +157,7 @@ class Equilibrium:
         factor's inertia is certified before it is reported, :meth:`factor`)."""
         self.problem = problem
         shell = problem.shell
+        compiled.prepare(len(shell.faces))   # a large shell's JIT kernels load beside the first evaluations
         self.X = shell.rest_positions.copy()
         self.n = shell.n_dofs
         self.terms = list(problem.energy_terms() if terms is None else terms)
