@@ -8,7 +8,8 @@ A kernel is a plain Python function of arrays decorated with :func:`kernel` in o
   exists, was built from the kernel sources as they are now (their SHA-256 is kept beside it, in
   ``_aot.json``) on this processor (it is compiled for the build machine's instruction set), holds the kernel for these argument types, and the call is small: a kernel that
   is parallel in the JIT build goes there only while its work (``args[work].shape[0]``) is at most
-  :data:`SERIAL_MAX`;
+  :data:`SERIAL_MAX` -- or at most :data:`LOADING_MAX` while its JIT overload is still being loaded
+  by the loader thread (:class:`_Loader`, :func:`prepare`);
 * otherwise the **JIT build**: numba's ``njit`` (``cache=True``, parallel where declared), which
   compiles (or loads from numba's on-disk cache) every kernel of the module on the first such call.
 
@@ -17,7 +18,7 @@ first call even when its on-disk cache is warm (it installs its typing and lower
 the plate of 1,681 control vertices took 1.2-1.6 s as a whole process, of which ~0.5 s was that.
 The ahead-of-time module loads like any extension (a few ms) and needs no numba at run time.
 Large problems keep the parallel JIT build (2 cores: the shell's Hessian assembly about 1.8x
-faster), where numba's fixed cost is small against the solve.
+faster), and numba's fixed cost is paid beside their first calls, in a thread of its own.
 
 The ahead-of-time exports release the GIL while they run (as ``njit(nogil=True)`` would: pycc's
 wrappers are built with numba's ``release_gil`` flag), so a term whose work is in such kernels can
